@@ -1,0 +1,53 @@
+# One place that decides how every posed target is compiled (DESIGN.md, Style).
+
+set(POSED_SANITIZER_FLAGS "")
+if(POSED_SANITIZE AND POSED_TSAN)
+  message(FATAL_ERROR "POSED_SANITIZE and POSED_TSAN cannot be combined")
+endif()
+if(POSED_SANITIZE)
+  set(POSED_SANITIZER_FLAGS -fsanitize=address,undefined -fno-sanitize-recover=undefined
+                            -fno-omit-frame-pointer)
+elseif(POSED_TSAN)
+  set(POSED_SANITIZER_FLAGS -fsanitize=thread -fno-omit-frame-pointer)
+endif()
+
+# posed_target_defaults(<target>): warnings, -Werror under POSED_WERROR, sanitizers.
+function(posed_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wconversion -Wshadow
+                                           -Wnon-virtual-dtor -Wpedantic)
+  if(POSED_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(POSED_SANITIZER_FLAGS)
+    target_compile_options(${target} PRIVATE ${POSED_SANITIZER_FLAGS})
+    target_link_options(${target} PRIVATE ${POSED_SANITIZER_FLAGS})
+  endif()
+endfunction()
+
+# posed_library(<name> SOURCES ... [LIBS ...]): a static library of one layer.
+function(posed_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(${name} PUBLIC ${ARG_LIBS})
+  posed_target_defaults(${name})
+endfunction()
+
+# posed_test(<name> LABEL unit|replay|integration|hw SOURCES ... [LIBS ...]):
+# one GoogleTest binary per area, each test discovered and labelled for ctest -L.
+function(posed_test name)
+  cmake_parse_arguments(ARG "" "LABEL;TIMEOUT" "SOURCES;LIBS" ${ARGN})
+  if(NOT ARG_LABEL)
+    message(FATAL_ERROR "posed_test(${name}) needs a LABEL")
+  endif()
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 120)
+  endif()
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
+  posed_target_defaults(${name})
+  gtest_discover_tests(${name}
+    PROPERTIES LABELS ${ARG_LABEL} TIMEOUT ${ARG_TIMEOUT}
+               ENVIRONMENT "POSED_SOURCE_DIR=${PROJECT_SOURCE_DIR};POSED_BUILD_DIR=${PROJECT_BINARY_DIR}"
+    DISCOVERY_TIMEOUT 60)
+endfunction()

@@ -1,0 +1,20 @@
+#pragma once
+// posectl's subcommands. Each lives in its own cmd_*.cpp and is listed once in commands.cpp.
+
+#include <span>
+#include <string_view>
+
+namespace posed::posectl {
+
+struct Command {
+  std::string_view name;
+  std::string_view summary;
+  /// argv[0] is the subcommand name; returns the process exit code.
+  int (*run)(int argc, char** argv);
+};
+
+std::span<const Command> commands();
+
+int run_bench(int argc, char** argv);
+
+}  // namespace posed::posectl
