@@ -1,0 +1,381 @@
+#include "daemon/config/config_loader.hpp"
+
+// yaml-cpp 0.7's node/impl.h trips GCC 12's -Wdangling-pointer (a false positive in its own
+// templates); silence it for that header only.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdangling-pointer"
+#include <yaml-cpp/yaml.h>
+#pragma GCC diagnostic pop
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "daemon/config/config_schema.hpp"
+
+namespace posed::config {
+namespace {
+
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+std::string format_number(double v) {
+  char buf[64];
+  if (v == std::floor(v) && std::fabs(v) < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+    return buf;
+  }
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // Shortest text that reads back exactly, so --print-config output can be loaded again.
+  for (int precision = 1; precision <= 17; ++precision) {
+    char shorter[64];
+    std::snprintf(shorter, sizeof shorter, "%.*g", precision, v);
+    if (std::strtod(shorter, nullptr) == v) return shorter;
+  }
+  return buf;
+}
+
+std::string range_text(const Field& f) {
+  std::string s = "[" + format_number(f.min) + ", " + format_number(f.max) + "]";
+  if (!f.unit.empty()) s += " " + std::string(f.unit);
+  return s;
+}
+
+class Loader {
+ public:
+  Loader(std::string_view file, PosedConfig& config, std::vector<ConfigError>& errors)
+      : file_(file), config_(config), errors_(errors) {}
+
+  void error(const YAML::Node& node, std::string_view key, std::string reason) {
+    const YAML::Mark mark = node.Mark();
+    errors_.push_back(ConfigError{file_, mark.line >= 0 ? mark.line + 1 : 0,
+                                  mark.column >= 0 ? mark.column + 1 : 0, std::string(key),
+                                  std::move(reason)});
+  }
+
+  // Walks a mapping; every leaf must be a schema key.
+  void walk(const YAML::Node& node, const std::string& prefix) {
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const YAML::Node& key_node = it->first;
+      const YAML::Node& value = it->second;
+      if (!key_node.IsScalar()) {
+        error(key_node, prefix, "keys must be plain names");
+        continue;
+      }
+      const std::string key = prefix.empty() ? key_node.Scalar() : prefix + "." + key_node.Scalar();
+      if (const Field* field = find_field(key)) {
+        apply(*field, value);
+      } else if (value.IsMap() && is_section(key)) {
+        walk(value, key);
+      } else {
+        error(key_node, key, "unknown key" + suggestion(key));
+      }
+    }
+  }
+
+  void apply(const Field& field, const YAML::Node& value) {
+    std::visit(Overloaded{
+                   [&](bool* out) { parse_bool(field, value, *out); },
+                   [&](int* out) { parse_int(field, value, *out); },
+                   [&](double* out) { parse_double(field, value, *out); },
+                   [&](std::string* out) { parse_string(field, value, *out); },
+                   [&](Rotation3* out) { parse_matrix(field, value, *out, 3); },
+                   [&](Transform4* out) { parse_matrix(field, value, *out, 4); },
+               },
+               field.ref(config_));
+  }
+
+ private:
+  static bool is_section(const std::string& key) {
+    const std::string prefix = key + ".";
+    for (const auto& f : schema()) {
+      if (f.key.substr(0, prefix.size()) == prefix) return true;
+    }
+    return false;
+  }
+
+  static std::string suggestion(const std::string& key) {
+    // The nearest key by edit distance, when it is close enough to be a typo.
+    std::string best;
+    std::size_t best_distance = 4;
+    for (const auto& f : schema()) {
+      const std::string candidate(f.key);
+      std::vector<std::size_t> row(candidate.size() + 1);
+      for (std::size_t j = 0; j < row.size(); ++j) row[j] = j;
+      for (std::size_t i = 1; i <= key.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= candidate.size(); ++j) {
+          const std::size_t up = row[j];
+          row[j] = std::min(
+              {row[j] + 1, row[j - 1] + 1, diagonal + (key[i - 1] == candidate[j - 1] ? 0u : 1u)});
+          diagonal = up;
+        }
+      }
+      if (row.back() < best_distance) {
+        best_distance = row.back();
+        best = candidate;
+      }
+    }
+    return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+  }
+
+  bool expect_scalar(const Field& f, const YAML::Node& v, std::string_view what) {
+    if (v.IsScalar()) return true;
+    error(v, f.key,
+          "expected " + std::string(what) + ", found a " +
+              (v.IsMap()        ? "mapping"
+               : v.IsSequence() ? "list"
+                                : "null value"));
+    return false;
+  }
+
+  void parse_bool(const Field& f, const YAML::Node& v, bool& out) {
+    if (!expect_scalar(f, v, "true or false")) return;
+    const std::string& s = v.Scalar();
+    if (s == "true" || s == "yes" || s == "on") {
+      out = true;
+    } else if (s == "false" || s == "no" || s == "off") {
+      out = false;
+    } else {
+      error(v, f.key, "expected true or false, found '" + s + "'");
+    }
+  }
+
+  bool parse_number(const Field& f, const YAML::Node& v, double& out) {
+    if (!expect_scalar(f, v, "a number")) return false;
+    const std::string& s = v.Scalar();
+    char* end = nullptr;
+    out = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(out)) {
+      error(v, f.key, "expected a number, found '" + s + "'");
+      return false;
+    }
+    return true;
+  }
+
+  void parse_int(const Field& f, const YAML::Node& v, int& out) {
+    double d = 0;
+    if (!parse_number(f, v, d)) return;
+    if (d != std::floor(d)) {
+      error(v, f.key, "expected a whole number, found '" + v.Scalar() + "'");
+      return;
+    }
+    if (d < f.min || d > f.max) {
+      error(v, f.key, v.Scalar() + " is out of range " + range_text(f));
+      return;
+    }
+    out = static_cast<int>(d);
+  }
+
+  void parse_double(const Field& f, const YAML::Node& v, double& out) {
+    double d = 0;
+    if (!parse_number(f, v, d)) return;
+    if (d < f.min || d > f.max) {
+      error(v, f.key, v.Scalar() + " is out of range " + range_text(f));
+      return;
+    }
+    out = d;
+  }
+
+  void parse_string(const Field& f, const YAML::Node& v, std::string& out) {
+    if (v.IsNull()) {
+      out.clear();
+      return;
+    }
+    if (!expect_scalar(f, v, "text")) return;
+    const std::string& s = v.Scalar();
+    if (!f.choices.empty()) {
+      bool allowed = false;
+      std::string_view rest = f.choices;
+      while (!rest.empty()) {
+        const auto bar = rest.find('|');
+        allowed = allowed || rest.substr(0, bar) == s;
+        rest = bar == std::string_view::npos ? std::string_view() : rest.substr(bar + 1);
+      }
+      if (!allowed) {
+        std::string options(f.choices);
+        for (auto& c : options) c = c == '|' ? ',' : c;
+        error(v, f.key, "'" + s + "' is not one of: " + options);
+        return;
+      }
+    }
+    out = s;
+  }
+
+  template <std::size_t N>
+  void parse_matrix(const Field& f, const YAML::Node& v, std::array<double, N>& out, int dim) {
+    if (!v.IsSequence() || v.size() != N) {
+      error(v, f.key,
+            "expected a list of " + std::to_string(N) + " numbers (row-major " +
+                std::to_string(dim) + "x" + std::to_string(dim) + ")" +
+                (v.IsSequence() ? ", found " + std::to_string(v.size()) : std::string()));
+      return;
+    }
+    std::array<double, N> m{};
+    for (std::size_t i = 0; i < N; ++i) {
+      const YAML::Node& e = v[i];
+      Field element = f;
+      element.min = -1e9;
+      element.max = 1e9;
+      if (!parse_number(element, e, m[i])) return;
+    }
+    Eigen::Matrix3d R;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) R(r, c) = m[static_cast<std::size_t>(r * dim + c)];
+    }
+    // M2DGR writes rotations to 5 decimals at best; 1e-4 accepts those and catches typos.
+    const double orthonormality = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
+    if (orthonormality > 1e-4 || R.determinant() < 0) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "the rotation part is not a rotation (|R^T R - I| = %.3g, det = %.3g); is the "
+                    "matrix transposed or a reflection?",
+                    orthonormality, R.determinant());
+      error(v, f.key, buf);
+      return;
+    }
+    if (dim == 4 && (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1)) {
+      error(v, f.key, "the last row of a 4x4 transform must be 0, 0, 0, 1");
+      return;
+    }
+    out = m;
+  }
+
+  std::string file_;
+  PosedConfig& config_;
+  std::vector<ConfigError>& errors_;
+};
+
+void check_cross_field(const PosedConfig& c, std::string_view file,
+                       std::vector<ConfigError>& errors) {
+  if (c.lidar.min_range_m >= c.lidar.max_range_m) {
+    errors.push_back(
+        {std::string(file), 0, 0, "lidar.min_range_m", "must be below lidar.max_range_m"});
+  }
+}
+
+}  // namespace
+
+std::string ConfigError::to_string() const {
+  std::string s = file;
+  if (line > 0) s += ":" + std::to_string(line) + ":" + std::to_string(column);
+  s += ": ";
+  if (!key.empty()) s += key + ": ";
+  return s + reason;
+}
+
+std::string LoadResult::error_text() const {
+  std::string s;
+  for (const auto& e : errors) s += e.to_string() + "\n";
+  return s;
+}
+
+PosedConfig default_config() {
+  PosedConfig config;
+  std::vector<ConfigError> errors;
+  Loader loader("<schema defaults>", config, errors);
+  for (const auto& field : schema())
+    loader.apply(field, YAML::Load(std::string(field.default_yaml)));
+  // A default that fails its own validation is a programming error; the unit test checks for it.
+  return config;
+}
+
+LoadResult load_config_text(std::string_view yaml_text, std::string_view name) {
+  LoadResult result;
+  result.config = default_config();
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::ParserException& e) {
+    result.errors.push_back(
+        {std::string(name), e.mark.line + 1, e.mark.column + 1, "", "not valid YAML: " + e.msg});
+    return result;
+  }
+  if (root.IsNull()) return result;  // an empty file means all defaults
+  if (!root.IsMap()) {
+    result.errors.push_back({std::string(name), root.Mark().line + 1, root.Mark().column + 1, "",
+                             "expected a mapping of sections at the top level"});
+    return result;
+  }
+  Loader loader(name, result.config, result.errors);
+  loader.walk(root, "");
+  if (result.errors.empty()) check_cross_field(result.config, name, result.errors);
+  return result;
+}
+
+LoadResult load_config_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    LoadResult result;
+    result.config = default_config();
+    result.errors.push_back({path, 0, 0, "", "cannot open: " + std::string(std::strerror(errno))});
+    return result;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return load_config_text(text.str(), path);
+}
+
+std::string print_config(const PosedConfig& config_in) {
+  PosedConfig config = config_in;  // FieldRef needs a mutable object; nothing is written
+  std::string out = "# posed effective configuration (value  # [unit] range: description)\n";
+  std::vector<std::string_view> open_sections;
+  for (const auto& f : schema()) {
+    // Split "a.b.c" into sections [a, b] and leaf c; close/open sections as the path changes.
+    std::vector<std::string_view> parts;
+    std::string_view rest = f.key;
+    for (auto dot = rest.find('.'); dot != std::string_view::npos; dot = rest.find('.')) {
+      parts.push_back(rest.substr(0, dot));
+      rest = rest.substr(dot + 1);
+    }
+    std::size_t common = 0;
+    while (common < parts.size() && common < open_sections.size() &&
+           parts[common] == open_sections[common]) {
+      ++common;
+    }
+    open_sections.resize(common);
+    for (std::size_t i = common; i < parts.size(); ++i) {
+      out += std::string(2 * i, ' ') + std::string(parts[i]) + ":\n";
+      open_sections.push_back(parts[i]);
+    }
+    std::string value = std::visit(
+        Overloaded{
+            [](bool* v) { return std::string(*v ? "true" : "false"); },
+            [](int* v) { return std::to_string(*v); },
+            [](double* v) { return format_number(*v); },
+            [](std::string* v) { return v->empty() ? std::string("\"\"") : "\"" + *v + "\""; },
+            [](Rotation3* m) {
+              std::string s = "[";
+              for (std::size_t i = 0; i < m->size(); ++i)
+                s += (i ? ", " : "") + format_number((*m)[i]);
+              return s + "]";
+            },
+            [](Transform4* m) {
+              std::string s = "[";
+              for (std::size_t i = 0; i < m->size(); ++i)
+                s += (i ? ", " : "") + format_number((*m)[i]);
+              return s + "]";
+            },
+        },
+        f.ref(config));
+    std::string comment;
+    if (!f.unit.empty()) comment += "[" + std::string(f.unit) + "] ";
+    if (f.max > f.min)
+      comment += "range " + range_text(f).substr(0, range_text(f).find(']') + 1) + " ";
+    if (!f.choices.empty()) comment += "one of " + std::string(f.choices) + " ";
+    comment += std::string(f.description);
+    out += std::string(2 * parts.size(), ' ') + std::string(rest) + ": " + value + "  # " +
+           comment + "\n";
+  }
+  return out;
+}
+
+}  // namespace posed::config

@@ -1,0 +1,173 @@
+#include "daemon/config/config_schema.hpp"
+
+#include <limits>
+
+namespace posed::config {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// F(key, member, default, unit, min, max, choices, description)
+#define F(key, member, def, unit, lo, hi, choices, desc)                                        \
+  Field {                                                                                       \
+    key, [](PosedConfig& c) -> FieldRef { return &c.member; }, def, unit, lo, hi, choices, desc \
+  }
+
+// The defaults are the M2DGR rig (DESIGN.md); config/posed.yaml repeats them with the
+// resolution of each catch in M2DGR's calibration files.
+const Field kSchema[] = {
+    F("dds.domain_id", dds.domain_id, "0", "", 0, 232, "", "DDS domain (ROS_DOMAIN_ID)"),
+    F("dds.map_frame", dds.map_frame, "map", "", 0, 0, "", "frame_id of published poses"),
+    F("dds.base_frame", dds.base_frame, "base_link", "", 0, 0, "",
+      "child_frame_id of published poses (the IMU frame)"),
+    F("dds.cyclonedds_config", dds.cyclonedds_config, "\"\"", "", 0, 0, "",
+      "Cyclone DDS XML file; empty uses CYCLONEDDS_URI or Cyclone's default"),
+
+    F("publish.odom_decimation", publish.odom_decimation, "1", "", 1, 1000, "",
+      "publish every Nth propagated state on rt/posed/odom"),
+    F("publish.pose_rate_hz", publish.pose_rate_hz, "10", "Hz", 0.1, 1000, "",
+      "rt/posed/pose rate while the estimator is strapdown"),
+    F("publish.status_rate_hz", publish.status_rate_hz, "1", "Hz", 0.1, 100, "",
+      "rt/posed/status rate"),
+
+    F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial",
+      "where IMU samples come from"),
+    F("imu.rate_hz", imu.rate_hz, "150", "Hz", 1, 2000, "", "nominal IMU sample rate"),
+    F("imu.serial_device", imu.serial_device, "/dev/posed-imu", "", 0, 0, "",
+      "A9 serial port (path or /dev/serial/by-id/...)"),
+    F("imu.serial_baud", imu.serial_baud, "921600", "baud", 9600, 4000000, "",
+      "A9 serial baud rate"),
+    F("imu.R_imu_sensor", imu.R_imu_sensor, "[1, 0, 0, 0, 1, 0, 0, 0, 1]", "", 0, 0, "",
+      "mounting rotation from the sensor's axes into the IMU frame (row-major 3x3)"),
+    F("imu.gyro_noise_density", imu.gyro_noise_density, "2.3417543020438883e-03", "rad/s/sqrt(Hz)",
+      0, 1, "", "gyroscope white noise"),
+    F("imu.gyro_random_walk", imu.gyro_random_walk, "1.4428407712885209e-05", "rad/s^2/sqrt(Hz)", 0,
+      1, "", "gyroscope bias random walk"),
+    F("imu.accel_noise_density", imu.accel_noise_density, "3.7686306102624571e-02",
+      "m/s^2/sqrt(Hz)", 0, 10, "", "accelerometer white noise"),
+    F("imu.accel_random_walk", imu.accel_random_walk, "1.1416642385952368e-03", "m/s^3/sqrt(Hz)", 0,
+      10, "", "accelerometer bias random walk"),
+    F("imu.gravity_mps2", imu.gravity_mps2, "9.805", "m/s^2", 9.7, 9.9, "",
+      "local gravity magnitude"),
+
+    F("synthetic_imu.rate_hz", synthetic_imu.rate_hz, "200", "Hz", 1, 2000, "",
+      "sample rate of the synthetic IMU"),
+    F("synthetic_imu.radius_m", synthetic_imu.radius_m, "5", "m", 0.5, 1000, "",
+      "radius of the synthetic circle"),
+    F("synthetic_imu.speed_mps", synthetic_imu.speed_mps, "1", "m/s", 0, 30, "",
+      "cruise speed along the circle"),
+    F("synthetic_imu.static_s", synthetic_imu.static_s, "2", "s", 0, 60, "",
+      "standing still before moving (for the gravity alignment)"),
+    F("synthetic_imu.ramp_s", synthetic_imu.ramp_s, "3", "s", 0.1, 60, "",
+      "time to reach cruise speed"),
+    F("synthetic_imu.gyro_noise_density", synthetic_imu.gyro_noise_density, "0", "rad/s/sqrt(Hz)",
+      0, 1, "", "white noise added to the synthetic gyroscope"),
+    F("synthetic_imu.accel_noise_density", synthetic_imu.accel_noise_density, "0", "m/s^2/sqrt(Hz)",
+      0, 10, "", "white noise added to the synthetic accelerometer"),
+    F("synthetic_imu.seed", synthetic_imu.seed, "1", "", 0, 2147483647, "",
+      "seed of the synthetic noise"),
+
+    F("lidar.enabled", lidar.enabled, "false", "", 0, 0, "", "read the VLP-32C"),
+    F("lidar.address", lidar.address, "192.168.1.201", "", 0, 0, "",
+      "sensor IPv4 address; datagrams from other senders are dropped"),
+    F("lidar.data_port", lidar.data_port, "2368", "", 1, 65535, "", "UDP port of data packets"),
+    F("lidar.position_port", lidar.position_port, "8308", "", 1, 65535, "",
+      "UDP port of position (GPRMC) packets"),
+    F("lidar.calibration", lidar.calibration, "\"\"", "", 0, 0, "",
+      "per-laser calibration (VeloView XML, ros-drivers or velodyne_decoder YAML)"),
+    F("lidar.min_range_m", lidar.min_range_m, "0.5", "m", 0, 10, "", "returns closer are dropped"),
+    F("lidar.max_range_m", lidar.max_range_m, "120", "m", 1, 300, "",
+      "returns farther are dropped"),
+    F("lidar.rpm", lidar.rpm, "600", "rpm", 300, 1200, "", "configured rotation speed"),
+
+    F("visible_camera.enabled", visible_camera.enabled, "false", "", 0, 0, "",
+      "read the D435i colour stream"),
+    F("visible_camera.device", visible_camera.device, "\"\"", "", 0, 0, "",
+      "V4L2 node, /dev/v4l/by-id/... or serial number"),
+    F("visible_camera.width", visible_camera.width, "640", "px", 1, 8192, "", "image width"),
+    F("visible_camera.height", visible_camera.height, "480", "px", 1, 8192, "", "image height"),
+    F("visible_camera.rate_hz", visible_camera.rate_hz, "15", "Hz", 1, 120, "", "frame rate"),
+    F("visible_camera.fx", visible_camera.fx, "617.971050917033", "px", 1, 1e5, "", "focal x"),
+    F("visible_camera.fy", visible_camera.fy, "616.445131524790", "px", 1, 1e5, "", "focal y"),
+    F("visible_camera.cx", visible_camera.cx, "327.710279392468", "px", 0, 1e5, "",
+      "principal point x"),
+    F("visible_camera.cy", visible_camera.cy, "253.976983707814", "px", 0, 1e5, "",
+      "principal point y"),
+    F("visible_camera.k1", visible_camera.k1, "0.148000794688248", "", -10, 10, "", "radial k1"),
+    F("visible_camera.k2", visible_camera.k2, "-0.217835187249065", "", -10, 10, "", "radial k2"),
+    F("visible_camera.p1", visible_camera.p1, "0", "", -1, 1, "", "tangential p1"),
+    F("visible_camera.p2", visible_camera.p2, "0", "", -1, 1, "", "tangential p2"),
+    F("visible_camera.latency_s", visible_camera.latency_s, "0", "s", 0, 1, "",
+      "arrival minus exposure midpoint when the stream has no clock"),
+
+    F("thermal_camera.enabled", thermal_camera.enabled, "false", "", 0, 0, "", "read the PLUG 617"),
+    F("thermal_camera.device", thermal_camera.device, "\"\"", "", 0, 0, "",
+      "V4L2 node, /dev/v4l/by-id/..., or GenICam id"),
+    F("thermal_camera.width", thermal_camera.width, "640", "px", 1, 8192, "", "image width"),
+    F("thermal_camera.height", thermal_camera.height, "512", "px", 1, 8192, "", "image height"),
+    F("thermal_camera.rate_hz", thermal_camera.rate_hz, "25", "Hz", 1, 120, "", "frame rate"),
+    F("thermal_camera.fx", thermal_camera.fx, "435.836180277211", "px", 1, 1e5, "", "focal x"),
+    F("thermal_camera.fy", thermal_camera.fy, "435.909430631362", "px", 1, 1e5, "", "focal y"),
+    F("thermal_camera.cx", thermal_camera.cx, "324.452753232850", "px", 0, 1e5, "",
+      "principal point x"),
+    F("thermal_camera.cy", thermal_camera.cy, "255.554320082190", "px", 0, 1e5, "",
+      "principal point y"),
+    F("thermal_camera.k1", thermal_camera.k1, "-0.436107594318055", "", -10, 10, "", "radial k1"),
+    F("thermal_camera.k2", thermal_camera.k2, "0.166413618922992", "", -10, 10, "", "radial k2"),
+    F("thermal_camera.p1", thermal_camera.p1, "0", "", -1, 1, "", "tangential p1"),
+    F("thermal_camera.p2", thermal_camera.p2, "0", "", -1, 1, "", "tangential p2"),
+    F("thermal_camera.latency_s", thermal_camera.latency_s, "0.03", "s", 0, 1, "",
+      "arrival minus exposure midpoint (the PLUG 617 over UVC has no clock)"),
+
+    F("extrinsics.T_imu_lidar", extrinsics.T_imu_lidar,
+      "[1, 0, 0, 0.27255, 0, 1, 0, -0.00053, 0, 0, 1, 0.17954, 0, 0, 0, 1]", "m", 0, 0, "",
+      "lidar pose in the IMU frame (row-major 4x4, translation in metres)"),
+    F("extrinsics.T_imu_cam", extrinsics.T_imu_cam,
+      "[0, 0, 1, 0.57711, -1, 0, 0, 0.00012, 0, -1, 0, 0.83330, 0, 0, 0, 1]", "m", 0, 0, "",
+      "visible camera pose in the IMU frame (camera x right, y down, z forward)"),
+    F("extrinsics.T_cam_thermal", extrinsics.T_cam_thermal,
+      "[1, 0, 0, -0.17, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]", "m", 0, 0, "",
+      "thermal camera pose in the visible camera frame"),
+
+    F("estimator.init_static_s", estimator.init_static_s, "1", "s", 0.05, 30, "",
+      "IMU averaged at start for the gravity alignment"),
+    F("estimator.init_max_gyro_radps", estimator.init_max_gyro_radps, "0.05", "rad/s", 0.001, 1, "",
+      "largest rate still counted as standing still during alignment"),
+
+    // SCHED_FIFO priorities: the maximum (50) must not exceed LimitRTPRIO in posed.service.
+    F("threads.imu_source.priority", threads.imu_source.priority, "0", "", 0, 50, "",
+      "SCHED_FIFO priority of the IMU source thread (0 = normal scheduling)"),
+    F("threads.imu_source.cpu", threads.imu_source.cpu, "-1", "", -1, 1023, "",
+      "CPU the IMU source thread is pinned to (-1 = any)"),
+    F("threads.fusion.priority", threads.fusion.priority, "0", "", 0, 50, "",
+      "SCHED_FIFO priority of the fusion thread (0 = normal scheduling)"),
+    F("threads.fusion.cpu", threads.fusion.cpu, "-1", "", -1, 1023, "",
+      "CPU the fusion thread is pinned to (-1 = any)"),
+    F("threads.publisher.priority", threads.publisher.priority, "0", "", 0, 50, "",
+      "SCHED_FIFO priority of the DDS publisher thread (0 = normal scheduling)"),
+    F("threads.publisher.cpu", threads.publisher.cpu, "-1", "", -1, 1023, "",
+      "CPU the DDS publisher thread is pinned to (-1 = any)"),
+
+    F("queues.imu_capacity", queues.imu_capacity, "1024", "samples", 8, 1048576, "",
+      "IMU queue between the IMU source and the fusion core (drop-oldest)"),
+    F("queues.state_capacity", queues.state_capacity, "1024", "states", 8, 1048576, "",
+      "state queue between the fusion core and the publisher (drop-oldest)"),
+
+    F("watchdog.stage_deadline_s", watchdog.stage_deadline_s, "1", "s", 0.01, 60, "",
+      "a stage silent this long stops the systemd watchdog"),
+};
+
+#undef F
+
+}  // namespace
+
+std::span<const Field> schema() { return kSchema; }
+
+const Field* find_field(std::string_view key) {
+  for (const auto& f : kSchema) {
+    if (f.key == key) return &f;
+  }
+  return nullptr;
+}
+
+}  // namespace posed::config

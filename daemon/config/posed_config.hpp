@@ -1,0 +1,125 @@
+#pragma once
+// posed's configuration as plain structs (DESIGN.md, Configuration). Every field is described,
+// with its unit, range and default, in exactly one place: the schema table in config_schema.cpp.
+// The values here are only what a default-constructed struct holds before the schema's defaults
+// are applied by default_config().
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace posed::config {
+
+/// A 4x4 homogeneous transform, row-major: T_a_b maps points from frame b into frame a.
+using Transform4 = std::array<double, 16>;
+/// A 3x3 rotation, row-major.
+using Rotation3 = std::array<double, 9>;
+
+struct DdsSection {
+  int domain_id = 0;
+  std::string map_frame;
+  std::string base_frame;
+  /// Cyclone DDS XML file; empty = CYCLONEDDS_URI or Cyclone's built-in default
+  std::string cyclonedds_config;
+};
+
+struct PublishSection {
+  int odom_decimation = 1;      ///< publish every Nth propagated state on rt/posed/odom
+  double pose_rate_hz = 10.0;   ///< rt/posed/pose rate while the estimator is strapdown [Hz]
+  double status_rate_hz = 1.0;  ///< rt/posed/status rate [Hz]
+};
+
+struct ImuSection {
+  std::string source;                ///< synthetic | serial
+  double rate_hz = 150.0;            ///< nominal sample rate [Hz]
+  std::string serial_device;         ///< path or /dev/serial/by-id/... of the A9
+  int serial_baud = 921600;          ///< [baud]
+  Rotation3 R_imu_sensor{};          ///< mounting rotation, sensor axes into the IMU frame
+  double gyro_noise_density = 0.0;   ///< [rad/s/sqrt(Hz)]
+  double gyro_random_walk = 0.0;     ///< [rad/s^2/sqrt(Hz)]
+  double accel_noise_density = 0.0;  ///< [m/s^2/sqrt(Hz)]
+  double accel_random_walk = 0.0;    ///< [m/s^3/sqrt(Hz)]
+  double gravity_mps2 = 9.805;       ///< local gravity magnitude [m/s^2]
+};
+
+struct SyntheticImuSection {
+  double rate_hz = 200.0;            ///< [Hz]
+  double radius_m = 5.0;             ///< circle radius [m]
+  double speed_mps = 1.0;            ///< cruise speed along the circle [m/s]
+  double static_s = 2.0;             ///< standing still at start, for gravity alignment [s]
+  double ramp_s = 3.0;               ///< time to reach cruise speed [s]
+  double gyro_noise_density = 0.0;   ///< [rad/s/sqrt(Hz)]
+  double accel_noise_density = 0.0;  ///< [m/s^2/sqrt(Hz)]
+  int seed = 1;                      ///< noise seed
+};
+
+struct LidarSection {
+  bool enabled = false;
+  std::string address;  ///< sensor IPv4 address; datagrams from elsewhere are dropped
+  int data_port = 2368;
+  int position_port = 8308;
+  std::string calibration;  ///< VeloView XML / ros-drivers YAML / velodyne_decoder YAML
+  double min_range_m = 0.5;
+  double max_range_m = 120.0;
+  double rpm = 600.0;
+};
+
+struct CameraSection {
+  bool enabled = false;
+  std::string device;                     ///< V4L2 path, /dev/v4l/by-id/..., or serial
+  int width = 0;                          ///< [px]
+  int height = 0;                         ///< [px]
+  double rate_hz = 0;                     ///< [Hz]
+  double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics [px]
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  ///< radial-tangential distortion
+  double latency_s = 0;  ///< host arrival minus exposure midpoint, for clockless streams [s]
+};
+
+struct ExtrinsicsSection {
+  Transform4 T_imu_lidar{};
+  Transform4 T_imu_cam{};
+  Transform4 T_cam_thermal{};
+};
+
+struct EstimatorSection {
+  double init_static_s = 1.0;         ///< IMU averaged for the gravity alignment [s]
+  double init_max_gyro_radps = 0.05;  ///< above this the rig is not static [rad/s]
+};
+
+/// One pipeline thread: SCHED_FIFO priority (0 = normal scheduling) and CPU (-1 = any).
+struct ThreadSection {
+  int priority = 0;
+  int cpu = -1;
+};
+
+struct ThreadsSection {
+  ThreadSection imu_source;
+  ThreadSection fusion;
+  ThreadSection publisher;
+};
+
+struct QueuesSection {
+  int imu_capacity = 1024;    ///< IMU samples between the IMU source and the fusion core
+  int state_capacity = 1024;  ///< propagated states between the fusion core and the publisher
+};
+
+struct WatchdogSection {
+  double stage_deadline_s = 1.0;  ///< a stage silent this long stops WATCHDOG=1 [s]
+};
+
+struct PosedConfig {
+  DdsSection dds;
+  PublishSection publish;
+  ImuSection imu;
+  SyntheticImuSection synthetic_imu;
+  LidarSection lidar;
+  CameraSection visible_camera;
+  CameraSection thermal_camera;
+  ExtrinsicsSection extrinsics;
+  EstimatorSection estimator;
+  ThreadsSection threads;
+  QueuesSection queues;
+  WatchdogSection watchdog;
+};
+
+}  // namespace posed::config

@@ -1,0 +1,207 @@
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "daemon/config/config_loader.hpp"
+#include "daemon/config/config_schema.hpp"
+
+namespace posed::config {
+namespace {
+
+LoadResult load(const std::string& text) { return load_config_text(text, "test.yaml"); }
+
+// One error, and it says where and why.
+void expect_single_error(const LoadResult& r, const std::string& key, int line,
+                         const std::string& reason_part) {
+  ASSERT_EQ(r.errors.size(), 1u) << r.error_text();
+  EXPECT_EQ(r.errors[0].file, "test.yaml");
+  EXPECT_EQ(r.errors[0].key, key);
+  EXPECT_EQ(r.errors[0].line, line) << r.error_text();
+  EXPECT_NE(r.errors[0].reason.find(reason_part), std::string::npos) << r.error_text();
+}
+
+TEST(Config, EveryDefaultPassesItsOwnValidation) {
+  // Loading each default through the file path must produce no error: the table is consistent.
+  for (const auto& f : schema()) {
+    std::string yaml;
+    std::string_view rest = f.key;
+    int depth = 0;
+    for (auto dot = rest.find('.'); dot != std::string_view::npos; dot = rest.find('.')) {
+      yaml += std::string(2 * static_cast<std::size_t>(depth++), ' ') +
+              std::string(rest.substr(0, dot)) + ":\n";
+      rest = rest.substr(dot + 1);
+    }
+    yaml += std::string(2 * static_cast<std::size_t>(depth), ' ') + std::string(rest) + ": " +
+            std::string(f.default_yaml) + "\n";
+    const auto r = load(yaml);
+    EXPECT_TRUE(r.ok()) << f.key << ": " << r.error_text();
+    EXPECT_FALSE(f.description.empty()) << f.key;
+  }
+}
+
+TEST(Config, KeysAreUnique) {
+  const auto fields = schema();
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    for (std::size_t j = i + 1; j < fields.size(); ++j) EXPECT_NE(fields[i].key, fields[j].key);
+  }
+}
+
+TEST(Config, DefaultsAreTheM2dgrRig) {
+  const PosedConfig c = default_config();
+  EXPECT_EQ(c.dds.map_frame, "map");
+  EXPECT_EQ(c.dds.base_frame, "base_link");
+  EXPECT_DOUBLE_EQ(c.imu.gravity_mps2, 9.805);
+  // Intrinsics read from M2DGR's transposed matrix: cx, cy are in its last row.
+  EXPECT_DOUBLE_EQ(c.visible_camera.cx, 327.710279392468);
+  EXPECT_DOUBLE_EQ(c.thermal_camera.fx, 435.836180277211);
+  EXPECT_DOUBLE_EQ(c.extrinsics.T_imu_lidar[3], 0.27255);
+}
+
+TEST(Config, EmptyFileMeansDefaults) {
+  const auto r = load("");
+  ASSERT_TRUE(r.ok()) << r.error_text();
+  EXPECT_EQ(r.config.imu.source, "serial");
+}
+
+TEST(Config, ValuesOverrideDefaults) {
+  const auto r = load("imu:\n  source: synthetic\n  rate_hz: 400\ndds:\n  domain_id: 7\n");
+  ASSERT_TRUE(r.ok()) << r.error_text();
+  EXPECT_EQ(r.config.imu.source, "synthetic");
+  EXPECT_DOUBLE_EQ(r.config.imu.rate_hz, 400);
+  EXPECT_EQ(r.config.dds.domain_id, 7);
+}
+
+TEST(Config, UnknownKeyNamesLineAndSuggests) {
+  const auto r = load("imu:\n  source: synthetic\n  rate_hzz: 400\n");
+  expect_single_error(r, "imu.rate_hzz", 3, "unknown key (did you mean 'imu.rate_hz'?)");
+}
+
+TEST(Config, UnknownSection) {
+  const auto r = load("camera:\n  fx: 1\n");
+  expect_single_error(r, "camera", 1, "unknown key");
+}
+
+TEST(Config, WrongTypeNumber) {
+  const auto r = load("imu:\n  rate_hz: fast\n");
+  expect_single_error(r, "imu.rate_hz", 2, "expected a number, found 'fast'");
+}
+
+TEST(Config, WrongTypeMappingForScalar) {
+  const auto r = load("imu:\n  rate_hz:\n    value: 3\n");
+  expect_single_error(r, "imu.rate_hz", 3, "expected a number, found a mapping");
+}
+
+TEST(Config, WrongTypeBool) {
+  const auto r = load("lidar:\n  enabled: maybe\n");
+  expect_single_error(r, "lidar.enabled", 2, "expected true or false");
+}
+
+TEST(Config, OutOfRangeDouble) {
+  const auto r = load("imu:\n  rate_hz: 5000\n");
+  expect_single_error(r, "imu.rate_hz", 2, "5000 is out of range [1, 2000] Hz");
+}
+
+TEST(Config, OutOfRangeInt) {
+  const auto r = load("threads:\n  fusion:\n    priority: 99\n");
+  expect_single_error(r, "threads.fusion.priority", 3, "99 is out of range [0, 50]");
+}
+
+TEST(Config, FractionalInt) {
+  const auto r = load("dds:\n  domain_id: 1.5\n");
+  expect_single_error(r, "dds.domain_id", 2, "expected a whole number");
+}
+
+TEST(Config, ChoiceNotAllowed) {
+  const auto r = load("imu:\n  source: usb\n");
+  expect_single_error(r, "imu.source", 2, "'usb' is not one of: synthetic,serial");
+}
+
+TEST(Config, MatrixWrongSize) {
+  const auto r = load("extrinsics:\n  T_imu_lidar: [1, 0, 0]\n");
+  expect_single_error(r, "extrinsics.T_imu_lidar", 2, "expected a list of 16 numbers");
+}
+
+TEST(Config, MatrixNotARotation) {
+  const auto r =
+      load("extrinsics:\n  T_imu_lidar: [1, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n");
+  expect_single_error(r, "extrinsics.T_imu_lidar", 2, "not a rotation");
+}
+
+TEST(Config, MatrixReflectionRejected) {
+  const auto r =
+      load("extrinsics:\n  T_imu_cam: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1]\n");
+  expect_single_error(r, "extrinsics.T_imu_cam", 2, "det = -1");
+}
+
+TEST(Config, MatrixBadLastRow) {
+  const auto r =
+      load("extrinsics:\n  T_imu_cam: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1]\n");
+  expect_single_error(r, "extrinsics.T_imu_cam", 2, "last row");
+}
+
+TEST(Config, MatrixElementNotANumber) {
+  // M2DGR's thermal matrix has a full-width comma; it must be caught, not misread.
+  const auto r = load("imu:\n  R_imu_sensor: [1, 0, \"0，0\", 0, 1, 0, 0, 0, 1]\n");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].key, "imu.R_imu_sensor");
+}
+
+TEST(Config, InvalidYamlNamesLine) {
+  const auto r = load("imu:\n  rate_hz: [1, 2\n");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_NE(r.errors[0].reason.find("not valid YAML"), std::string::npos);
+  EXPECT_GT(r.errors[0].line, 0);
+}
+
+TEST(Config, TopLevelMustBeAMapping) {
+  const auto r = load("- a\n- b\n");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_NE(r.errors[0].reason.find("mapping"), std::string::npos);
+}
+
+TEST(Config, AllErrorsReportedAtOnce) {
+  const auto r = load("imu:\n  rate_hz: 0\n  source: usb\nbogus: 1\n");
+  EXPECT_EQ(r.errors.size(), 3u) << r.error_text();
+}
+
+TEST(Config, CrossFieldCheck) {
+  const auto r = load("lidar:\n  min_range_m: 5\n  max_range_m: 4\n");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].key, "lidar.min_range_m");
+}
+
+TEST(Config, MissingFileSaysWhy) {
+  const auto r = load_config_file("/nonexistent/posed.yaml");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_NE(r.errors[0].to_string().find("/nonexistent/posed.yaml: cannot open"),
+            std::string::npos);
+}
+
+TEST(Config, ErrorTextFormat) {
+  const auto r = load("imu:\n  rate_hz: 5000\n");
+  EXPECT_EQ(r.errors.at(0).to_string(),
+            "test.yaml:2:12: imu.rate_hz: 5000 is out of range [1, 2000] Hz");
+}
+
+TEST(Config, PrintedConfigLoadsBackIdentically) {
+  auto r = load("imu:\n  source: synthetic\n  rate_hz: 123.25\ndds:\n  domain_id: 3\n");
+  ASSERT_TRUE(r.ok());
+  const std::string printed = print_config(r.config);
+  EXPECT_NE(printed.find("rate_hz: 123.25  # [Hz] range [1, 2000]"), std::string::npos) << printed;
+  const auto again = load(printed);
+  ASSERT_TRUE(again.ok()) << again.error_text() << printed;
+  EXPECT_EQ(print_config(again.config), printed);
+}
+
+TEST(Config, ShippedConfigsLoad) {
+  const char* src = std::getenv("POSED_SOURCE_DIR");
+  ASSERT_NE(src, nullptr) << "POSED_SOURCE_DIR is set by ctest";
+  for (const char* name : {"/config/posed.yaml", "/config/demo.yaml"}) {
+    const auto r = load_config_file(std::string(src) + name);
+    EXPECT_TRUE(r.ok()) << name << ":\n" << r.error_text();
+  }
+}
+
+}  // namespace
+}  // namespace posed::config
