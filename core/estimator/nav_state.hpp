@@ -1,0 +1,46 @@
+#pragma once
+// The estimator's output: the pose of base_link in map, with velocity and uncertainty.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string_view>
+
+#include "core/time.hpp"
+
+namespace posed {
+
+enum class EstimatorMode : std::uint8_t {
+  kAligning,   ///< collecting the static window for the gravity alignment; no pose yet
+  kStrapdown,  ///< IMU-only dead reckoning: drifts without bound, no aiding
+};
+
+constexpr std::string_view to_string(EstimatorMode m) {
+  switch (m) {
+    case EstimatorMode::kAligning:
+      return "aligning";
+    case EstimatorMode::kStrapdown:
+      return "strapdown";
+  }
+  return "unknown";
+}
+
+struct NavState {
+  /// host clock
+  HostTime stamp;
+  Eigen::Vector3d p_map_base_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_map_base = Eigen::Quaterniond::Identity();
+  /// velocity of base_link in map [m/s]
+  Eigen::Vector3d v_map_mps = Eigen::Vector3d::Zero();
+  /// bias-corrected angular rate in base_link [rad/s]
+  Eigen::Vector3d w_base_radps = Eigen::Vector3d::Zero();
+  /// pose covariance, ROS order (x, y, z, rot x, rot y, rot z), map-fixed axes [m^2, rad^2]
+  Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  /// twist covariance, ROS order (vx, vy, vz, wx, wy, wz) in base_link [(m/s)^2, (rad/s)^2]
+  Eigen::Matrix<double, 6, 6> twist_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  EstimatorMode mode = EstimatorMode::kStrapdown;
+  /// increments with every state
+  std::uint64_t sequence = 0;
+};
+
+}  // namespace posed
