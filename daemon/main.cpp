@@ -1,1 +1,58 @@
-int main() { return 0; }
+// posed: the driver-to-pose daemon. Reads the configured sensors, fuses them, and publishes the
+// robot's pose over DDS (ROS 2 types), as a systemd service or from a terminal.
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <string>
+
+#include "daemon/build_info.hpp"
+#include "daemon/config/config_loader.hpp"
+#include "daemon/run_daemon.hpp"
+#include "drivers/common/log.hpp"
+
+int main(int argc, char** argv) noexcept try {
+  posed::log::set_program_name("posed");
+  CLI::App app{
+      "posed: real-time driver-to-pose daemon. Reads the VLP-32C, D435i, PLUG 617 and A9 (or the\n"
+      "synthetic IMU), puts every sample on the host clock, fuses them and publishes the pose on\n"
+      "DDS topics rt/posed/odom, rt/posed/pose and rt/posed/status (ROS 2 types).\n"
+      "SIGTERM or SIGINT drains and exits 0; a second one aborts.",
+      "posed"};
+  posed::RunOptions options;
+  bool print_config = false;
+  bool version = false;
+  app.add_option("-c,--config", options.config_path, "configuration file (YAML)")
+      ->capture_default_str();
+  app.add_flag("--print-config", print_config,
+               "print the effective configuration with units, ranges and descriptions, then exit");
+  app.add_option("--duration", options.duration_s,
+                 "stop by itself after this long [s]; 0 runs until SIGTERM/SIGINT")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--version", version, "print the version and exit");
+  CLI11_PARSE(app, argc, argv);
+
+  if (version) {
+    std::printf("%.*s\n", static_cast<int>(posed::version_string().size()),
+                posed::version_string().data());
+    return 0;
+  }
+  const auto loaded = posed::config::load_config_file(options.config_path);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "posed: invalid configuration:\n%s", loaded.error_text().c_str());
+    return 2;
+  }
+  if (print_config) {
+    std::fputs(posed::config::print_config(loaded.config).c_str(), stdout);
+    return 0;
+  }
+  return posed::run_daemon(loaded.config, options);
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "posed: error: %s\n", e.what());
+  return 1;
+} catch (...) {
+  std::fprintf(stderr, "posed: error: unknown exception\n");
+  return 1;
+}

@@ -321,7 +321,16 @@ LoadResult load_config_file(const std::string& path) {
   }
   std::stringstream text;
   text << in.rdbuf();
-  return load_config_text(text.str(), path);
+  LoadResult result = load_config_text(text.str(), path);
+  // Paths in a config file are relative to that file, wherever posed is started from.
+  const auto slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+  for (const auto& f : schema()) {
+    if (!f.is_path) continue;
+    std::string& value = *std::get<std::string*>(f.ref(result.config));
+    if (!value.empty() && value.front() != '/') value = dir + "/" + value;
+  }
+  return result;
 }
 
 std::string print_config(const PosedConfig& config_in) {

@@ -1,16 +1,18 @@
 #include "daemon/config/config_schema.hpp"
 
-#include <limits>
-
 namespace posed::config {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // F(key, member, default, unit, min, max, choices, description)
 #define F(key, member, def, unit, lo, hi, choices, desc)                                        \
   Field {                                                                                       \
     key, [](PosedConfig& c) -> FieldRef { return &c.member; }, def, unit, lo, hi, choices, desc \
+  }
+
+// P(key, member, description): a file path, resolved against the config file's directory.
+#define P(key, member, desc)                                                                    \
+  Field {                                                                                       \
+    key, [](PosedConfig& c) -> FieldRef { return &c.member; }, "\"\"", "", 0, 0, "", desc, true \
   }
 
 // The defaults are the M2DGR rig (DESIGN.md); config/posed.yaml repeats them with the
@@ -20,7 +22,7 @@ const Field kSchema[] = {
     F("dds.map_frame", dds.map_frame, "map", "", 0, 0, "", "frame_id of published poses"),
     F("dds.base_frame", dds.base_frame, "base_link", "", 0, 0, "",
       "child_frame_id of published poses (the IMU frame)"),
-    F("dds.cyclonedds_config", dds.cyclonedds_config, "\"\"", "", 0, 0, "",
+    P("dds.cyclonedds_config", dds.cyclonedds_config,
       "Cyclone DDS XML file; empty uses CYCLONEDDS_URI or Cyclone's default"),
 
     F("publish.odom_decimation", publish.odom_decimation, "1", "", 1, 1000, "",
@@ -66,6 +68,8 @@ const Field kSchema[] = {
       0, 10, "", "white noise added to the synthetic accelerometer"),
     F("synthetic_imu.seed", synthetic_imu.seed, "1", "", 0, 2147483647, "",
       "seed of the synthetic noise"),
+    F("synthetic_imu.hang_after_s", synthetic_imu.hang_after_s, "0", "s", 0, 1e6, "",
+      "fault injection: the fake device hangs in read() after this long (0 = never)"),
 
     F("lidar.enabled", lidar.enabled, "false", "", 0, 0, "", "read the VLP-32C"),
     F("lidar.address", lidar.address, "192.168.1.201", "", 0, 0, "",
@@ -73,7 +77,7 @@ const Field kSchema[] = {
     F("lidar.data_port", lidar.data_port, "2368", "", 1, 65535, "", "UDP port of data packets"),
     F("lidar.position_port", lidar.position_port, "8308", "", 1, 65535, "",
       "UDP port of position (GPRMC) packets"),
-    F("lidar.calibration", lidar.calibration, "\"\"", "", 0, 0, "",
+    P("lidar.calibration", lidar.calibration,
       "per-laser calibration (VeloView XML, ros-drivers or velodyne_decoder YAML)"),
     F("lidar.min_range_m", lidar.min_range_m, "0.5", "m", 0, 10, "", "returns closer are dropped"),
     F("lidar.max_range_m", lidar.max_range_m, "120", "m", 1, 300, "",
@@ -158,6 +162,7 @@ const Field kSchema[] = {
 };
 
 #undef F
+#undef P
 
 }  // namespace
 

@@ -30,6 +30,8 @@ struct Field {
   /// for strings with a closed set of values: "a|b|c"; empty = free text
   std::string_view choices;
   std::string_view description;
+  /// a file path: relative values are resolved against the config file's directory
+  bool is_path = false;
 };
 
 std::span<const Field> schema();

@@ -51,6 +51,7 @@ struct SyntheticImuSection {
   double gyro_noise_density = 0.0;   ///< [rad/s/sqrt(Hz)]
   double accel_noise_density = 0.0;  ///< [m/s^2/sqrt(Hz)]
   int seed = 1;                      ///< noise seed
+  double hang_after_s = 0;           ///< fault injection: the fake device hangs after this long [s]
 };
 
 struct LidarSection {

@@ -65,6 +65,10 @@ class Source {
   /// Makes a blocked or later read() return kEndOfStream. Safe from any thread.
   virtual void request_stop() = 0;
   virtual SourceCounters counters() const = 0;
+  /// Live: data arrives in real time and must never wait for the pipeline (queues drop the
+  /// oldest). Not live (recordings, generators at full speed): nothing may be lost, so the
+  /// pipeline blocks the Source instead, and results are deterministic.
+  virtual bool live() const { return true; }
 };
 
 }  // namespace posed::drivers

@@ -205,3 +205,18 @@ TEST(Config, ShippedConfigsLoad) {
 
 }  // namespace
 }  // namespace posed::config
+
+namespace posed::config {
+namespace {
+
+TEST(Config, RelativePathsResolveAgainstTheConfigFile) {
+  const char* src = std::getenv("POSED_SOURCE_DIR");
+  ASSERT_NE(src, nullptr);
+  const auto r = load_config_file(std::string(src) + "/config/demo.yaml");
+  ASSERT_TRUE(r.ok()) << r.error_text();
+  EXPECT_EQ(r.config.dds.cyclonedds_config, std::string(src) + "/config/cyclonedds-loopback.xml");
+  EXPECT_EQ(r.config.lidar.calibration, "");  // empty stays empty
+}
+
+}  // namespace
+}  // namespace posed::config

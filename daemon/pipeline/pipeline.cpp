@@ -1,0 +1,308 @@
+#include "daemon/pipeline/pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+#include "core/estimator/strapdown.hpp"
+#include "core/sync/clock_sync.hpp"
+#include "daemon/pipeline/thread_policy.hpp"
+#include "drivers/common/host_clock.hpp"
+#include "drivers/common/log.hpp"
+#include "drivers/imu/a9_protocol.hpp"
+
+namespace posed::pipeline {
+
+namespace a9 = drivers::a9;
+
+namespace {
+constexpr auto kWaitTimeout = std::chrono::milliseconds(50);
+const Duration kReadTimeout = Duration::from_ms(100);
+
+DropPolicy queue_policy(const PipelineSources& sources) {
+  return sources.imu && !sources.imu->live() ? DropPolicy::kBlockWithTimeout
+                                             : DropPolicy::kDropOldest;
+}
+
+a9::A9Mounting mounting_from(const config::Rotation3& R) {
+  a9::A9Mounting m;
+  for (std::size_t r = 0; r < 3; ++r) {
+    for (std::size_t c = 0; c < 3; ++c) m.R_imu_sensor[r][c] = R[r * 3 + c];
+  }
+  return m;
+}
+}  // namespace
+
+// State owned by one stage thread each; what other threads read goes through atomics or the
+// snapshot mutex.
+struct Pipeline::Impl {
+  // imu_source thread
+  a9::A9Decoder decoder;
+  ClockSync imu_clock;
+  a9::A9Mounting mounting;
+  // fusion thread
+  Strapdown strapdown;
+
+  // shared, for status()
+  std::atomic<std::uint64_t> imu_received{0};
+  std::atomic<std::uint64_t> imu_decoded{0};
+  std::atomic<std::uint64_t> imu_malformed{0};
+  std::atomic<std::uint64_t> states{0};
+  std::atomic<EstimatorMode> mode{EstimatorMode::kAligning};
+  std::atomic<bool> imu_lost{false};
+  mutable std::mutex snapshot_mutex;
+  ClockSyncStatus imu_clock_status;  // guarded by snapshot_mutex
+
+  Impl(const config::PosedConfig& c)
+      : imu_clock(ClockSyncConfig{.kind = DeviceClockKind::kCounterUs32Bit,
+                                  .nominal_rate_hz = c.imu.source == "synthetic"
+                                                         ? c.synthetic_imu.rate_hz
+                                                         : c.imu.rate_hz}),
+        mounting(mounting_from(c.imu.R_imu_sensor)),
+        strapdown(StrapdownConfig{
+            .gravity_mps2 = c.imu.gravity_mps2,
+            .init_static = Duration::from_seconds(c.estimator.init_static_s),
+            .init_max_gyro_radps = c.estimator.init_max_gyro_radps,
+            .gyro_noise_density = c.imu.gyro_noise_density,
+            .accel_noise_density = c.imu.accel_noise_density,
+        }) {}
+};
+
+Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
+                   PipelineOutputs outputs)
+    : config_(config),
+      sources_(std::move(sources)),
+      outputs_(std::move(outputs)),
+      // Live sensors: a stalled consumer must not make us process stale data later. Recordings
+      // and generators: nothing may be lost, so the producer waits (deterministic replays).
+      imu_queue_(static_cast<std::size_t>(config.queues.imu_capacity), queue_policy(sources_),
+                 std::chrono::seconds(1)),
+      state_queue_(static_cast<std::size_t>(config.queues.state_capacity), queue_policy(sources_),
+                   std::chrono::seconds(1)),
+      impl_(std::make_unique<Impl>(config)) {}
+
+Pipeline::~Pipeline() {
+  request_stop();
+  join();
+}
+
+bool Pipeline::start(std::string& error) {
+  if (!sources_.imu) {
+    error = "no IMU source configured";
+    return false;
+  }
+  std::string open_error;
+  if (!sources_.imu->open(open_error)) {
+    // The device may appear later (USB enumeration, cable): the Source retries on read().
+    POSED_LOG_WARN("IMU source not open yet: %s; retrying in the background", open_error.c_str());
+  }
+  const std::int64_t now = drivers::host_now().ns;
+  for (auto& h : heartbeat_ns_) h.store(now);
+  threads_.emplace_back([this] { run_imu_source(); });
+  threads_.emplace_back([this] { run_fusion(); });
+  threads_.emplace_back([this] { run_publisher(); });
+  return true;
+}
+
+void Pipeline::request_stop() {
+  if (sources_.imu) sources_.imu->request_stop();
+}
+
+void Pipeline::join() {
+  for (auto& t : threads_) {
+    if (t.joinable()) t.join();
+  }
+  threads_.clear();
+}
+
+void Pipeline::beat(Stage stage) {
+  heartbeat_ns_[static_cast<std::size_t>(stage)].store(drivers::host_now().ns,
+                                                       std::memory_order_relaxed);
+}
+
+std::array<HostTime, kStageNames.size()> Pipeline::stage_heartbeats() const {
+  std::array<HostTime, kStageNames.size()> out;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = HostTime::from_ns(heartbeat_ns_[i].load(std::memory_order_relaxed));
+  }
+  return out;
+}
+
+void Pipeline::run_imu_source() {
+  apply_thread_policy("posed-imu", config_.threads.imu_source);
+  Impl& s = *impl_;
+  drivers::Source& source = *sources_.imu;
+  drivers::RawChunk chunk;
+  bool reported_lost = false;
+  std::uint64_t malformed_seen = 0;
+  bool pushed = false;
+
+  const auto on_frame = [&](const a9::A9Frame& frame) {
+    if (frame.kind != a9::FrameKind::kSensor) return;
+    const HostTime stamp = s.imu_clock.map_raw(frame.sensor.counter_us, chunk.host_receive);
+    if (const ClockEvent e = s.imu_clock.last_event(); e != ClockEvent::kNone) {
+      const bool bad = e == ClockEvent::kReset || e == ClockEvent::kJump || e == ClockEvent::kLost;
+      log::write(bad ? log::Level::kWarning : log::Level::kInfo, "imu clock: %.*s",
+                 static_cast<int>(to_string(e).size()), to_string(e).data());
+    }
+    const DeviceTime device_stamp = s.imu_clock.status().last_device_stamp;
+    imu_queue_.push(
+        ImuItem{a9::to_imu_sample(frame.sensor, s.mounting, stamp, device_stamp), false});
+    s.imu_decoded.fetch_add(1, std::memory_order_relaxed);
+    pushed = true;
+  };
+  // Frames the decoder rejected since the last look (CRC, truncation, unknown kind).
+  const auto count_malformed = [&] {
+    const auto& c = s.decoder.counters();
+    const std::uint64_t now_malformed = c.bad_crc + c.truncated + c.unknown_kind;
+    if (now_malformed != malformed_seen) s.imu_malformed.fetch_add(now_malformed - malformed_seen);
+    malformed_seen = now_malformed;
+  };
+  const auto publish_progress = [&] {
+    if (!pushed) return;
+    pushed = false;
+    imu_ready_.signal();
+    std::lock_guard lock(s.snapshot_mutex);
+    s.imu_clock_status = s.imu_clock.status();
+  };
+
+  for (;;) {
+    beat(Stage::kImuSource);
+    const drivers::ReadStatus rs = source.read(chunk, kReadTimeout);
+    if (rs == drivers::ReadStatus::kEndOfStream) break;
+    if (rs == drivers::ReadStatus::kDeviceLost) {
+      if (!reported_lost) POSED_LOG_WARN("IMU device lost; waiting for it to come back");
+      reported_lost = true;
+      s.imu_lost.store(true);
+      continue;
+    }
+    if (rs != drivers::ReadStatus::kData) continue;
+    if (reported_lost) POSED_LOG_NOTICE("IMU device back");
+    reported_lost = false;
+    s.imu_lost.store(false);
+    s.imu_received.fetch_add(1, std::memory_order_relaxed);
+
+    s.decoder.feed(
+        std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(chunk.bytes.data()),
+                                      chunk.bytes.size()),
+        on_frame);
+    count_malformed();
+    publish_progress();
+  }
+  // End of stream: a partial frame left in the decoder is counted; frames hidden behind it kept.
+  s.decoder.finish(on_frame);
+  count_malformed();
+  publish_progress();
+  imu_queue_.push(ImuItem{{}, true});
+  imu_ready_.signal();
+  finished_stages_.fetch_add(1);
+}
+
+void Pipeline::run_fusion() {
+  apply_thread_policy("posed-fusion", config_.threads.fusion);
+  Impl& s = *impl_;
+  bool done = false;
+  while (!done) {
+    beat(Stage::kFusion);
+    imu_ready_.wait_for(kWaitTimeout);
+    ImuItem item;
+    bool produced = false;
+    while (imu_queue_.try_pop(item)) {
+      if (item.end_of_stream) {
+        done = true;
+        break;
+      }
+      if (auto state = s.strapdown.add(item.sample)) {
+        state_queue_.push(StateItem{*state, false});
+        s.states.fetch_add(1, std::memory_order_relaxed);
+        produced = true;
+      }
+      s.mode.store(s.strapdown.mode(), std::memory_order_relaxed);
+    }
+    if (produced) state_ready_.signal();
+  }
+  state_queue_.push(StateItem{{}, true});
+  state_ready_.signal();
+  finished_stages_.fetch_add(1);
+}
+
+void Pipeline::run_publisher() {
+  apply_thread_policy("posed-publish", config_.threads.publisher);
+  const Duration status_period = Duration::from_seconds(1.0 / config_.publish.status_rate_hz);
+  HostTime next_status = drivers::host_now() + status_period;
+  PipelineStatus previous;
+  bool done = false;
+  while (!done) {
+    beat(Stage::kPublisher);
+    state_ready_.wait_for(kWaitTimeout);
+    StateItem item;
+    while (state_queue_.try_pop(item)) {
+      if (item.end_of_stream) {
+        done = true;
+        break;
+      }
+      if (outputs_.on_state) outputs_.on_state(item.state);
+    }
+    const HostTime now = drivers::host_now();
+    if (done || now >= next_status) {
+      next_status = now + status_period;
+      PipelineStatus st = status();
+      // Rates from the difference to the previous snapshot, which only this thread keeps.
+      if (previous.stamp.ns != 0 && st.stamp > previous.stamp) {
+        const double dt = (st.stamp - previous.stamp).seconds();
+        for (std::size_t i = 0; i < st.streams.size() && i < previous.streams.size(); ++i) {
+          st.streams[i].rate_hz =
+              static_cast<double>(st.streams[i].decoded - previous.streams[i].decoded) / dt;
+        }
+      }
+      previous = st;
+      if (outputs_.on_status) outputs_.on_status(st);
+    }
+  }
+  finished_stages_.fetch_add(1);
+}
+
+PipelineStatus Pipeline::status() const {
+  const Impl& s = *impl_;
+  const HostTime now = drivers::host_now();
+  PipelineStatus st;
+  st.stamp = now;
+  st.mode = s.mode.load();
+  st.states = s.states.load();
+  st.states_dropped = state_queue_.counters().dropped();
+
+  StreamStatus imu;
+  imu.name = "imu";
+  imu.received = s.imu_received.load();
+  imu.decoded = s.imu_decoded.load();
+  imu.malformed = s.imu_malformed.load();
+  imu.dropped = imu_queue_.counters().dropped();
+  ClockSyncStatus clock;
+  {
+    std::lock_guard lock(s.snapshot_mutex);
+    clock = s.imu_clock_status;
+  }
+  imu.clock_offset_ns = clock.offset.ns;
+  imu.clock_drift_ppm = clock.drift_ppm;
+  imu.clock_jitter_ns = static_cast<double>(clock.jitter.ns);
+  imu.clock_uncertainty_ns = static_cast<double>(clock.uncertainty.ns);
+  // Silence for a second means lost, whatever the estimate said last; only meaningful for live
+  // Sources, whose arrival times are on this host's clock (a replay's are the recording's).
+  const bool live = sources_.imu && sources_.imu->live();
+  const bool stale = clock.samples == 0 || (live && now - clock.last_arrival > Duration::from_s(1));
+  imu.clock_state =
+      std::string(to_string(stale && clock.samples > 0 ? SyncState::kLost : clock.state));
+  if (s.imu_lost.load()) {
+    imu.health = "device_lost";
+  } else if (imu.decoded == 0 || stale) {
+    imu.health = "no_data";
+  } else if (imu.malformed > 0 || imu.dropped > 0) {
+    imu.health = "degraded";
+  } else {
+    imu.health = "ok";
+  }
+  st.streams.push_back(std::move(imu));
+  return st;
+}
+
+}  // namespace posed::pipeline

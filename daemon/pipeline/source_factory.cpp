@@ -1,0 +1,32 @@
+#include "daemon/pipeline/source_factory.hpp"
+
+namespace posed::pipeline {
+
+drivers::SyntheticImuConfig synthetic_imu_config(const config::PosedConfig& config) {
+  drivers::SyntheticImuConfig c;
+  c.motion.radius_m = config.synthetic_imu.radius_m;
+  c.motion.speed_mps = config.synthetic_imu.speed_mps;
+  c.motion.static_s = config.synthetic_imu.static_s;
+  c.motion.ramp_s = config.synthetic_imu.ramp_s;
+  c.motion.gravity_mps2 = config.imu.gravity_mps2;
+  c.rate_hz = config.synthetic_imu.rate_hz;
+  c.gyro_noise_density = config.synthetic_imu.gyro_noise_density;
+  c.accel_noise_density = config.synthetic_imu.accel_noise_density;
+  c.seed = static_cast<std::uint64_t>(config.synthetic_imu.seed);
+  c.hang_after_s = config.synthetic_imu.hang_after_s;
+  return c;
+}
+
+BuiltSources make_sources(const config::PosedConfig& config, std::string& error) {
+  BuiltSources built;
+  if (config.imu.source == "synthetic") {
+    auto source = std::make_unique<drivers::SyntheticImuSource>(synthetic_imu_config(config));
+    built.synthetic = source.get();
+    built.sources.imu = std::move(source);
+  } else {
+    error = "imu.source '" + config.imu.source + "' is not available in this build";
+  }
+  return built;
+}
+
+}  // namespace posed::pipeline

@@ -1,0 +1,110 @@
+#pragma once
+// Runs the posed executable as a separate process, the way systemd or a user would, with its
+// output captured to files and signals delivered for real.
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace posed::testing {
+
+inline std::string source_dir() {
+  const char* s = std::getenv("POSED_SOURCE_DIR");
+  return s ? s : ".";
+}
+inline std::string build_dir() {
+  const char* s = std::getenv("POSED_BUILD_DIR");
+  return s ? s : ".";
+}
+
+/// A fresh directory under /tmp, removed with its files when the object dies.
+class TempDir {
+ public:
+  TempDir() {
+    char pattern[] = "/tmp/posed-test-XXXXXX";
+    path_ = ::mkdtemp(pattern);
+  }
+  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(file(name)) << text;
+    return file(name);
+  }
+
+ private:
+  std::string path_;
+};
+
+inline std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class PosedProcess {
+ public:
+  /// Starts `argv` (argv[0] a path) with extra environment; `set_watchdog_pid` puts the child's
+  /// own pid in WATCHDOG_PID, as systemd does.
+  PosedProcess(const std::vector<std::string>& argv, const std::vector<std::string>& env,
+               const TempDir& dir, bool set_watchdog_pid = false)
+      : stdout_path_(dir.file("stdout.txt")), stderr_path_(dir.file("stderr.txt")) {
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      for (const auto& e : env) ::putenv(const_cast<char*>(e.c_str()));
+      if (set_watchdog_pid) ::setenv("WATCHDOG_PID", std::to_string(::getpid()).c_str(), 1);
+      std::freopen(stdout_path_.c_str(), "w", stdout);
+      std::freopen(stderr_path_.c_str(), "w", stderr);
+      std::vector<char*> args;
+      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+      args.push_back(nullptr);
+      ::execv(args[0], args.data());
+      std::_Exit(127);
+    }
+  }
+  ~PosedProcess() {
+    if (pid_ > 0 && !exited_) {
+      ::kill(pid_, SIGKILL);
+      int status = 0;
+      ::waitpid(pid_, &status, 0);
+    }
+  }
+
+  pid_t pid() const { return pid_; }
+  void signal(int sig) const { ::kill(pid_, sig); }
+
+  /// The exit code once the process ended within `timeout`; -1 for death by a signal.
+  std::optional<int> wait_for_exit(std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return std::nullopt;
+  }
+
+  std::string out() const { return read_file(stdout_path_); }
+  std::string err() const { return read_file(stderr_path_); }
+
+ private:
+  std::string stdout_path_;
+  std::string stderr_path_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+};
+
+}  // namespace posed::testing
