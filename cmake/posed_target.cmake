@@ -46,6 +46,10 @@ function(posed_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
   posed_target_defaults(${name})
+  # Where the tests find the sources (config/, ../shared/realdata) and the built executables;
+  # the environment variables of the same names override these.
+  target_compile_definitions(${name} PRIVATE POSED_SOURCE_DIR_DEFAULT="${PROJECT_SOURCE_DIR}"
+                                             POSED_BUILD_DIR_DEFAULT="${PROJECT_BINARY_DIR}")
   gtest_discover_tests(${name}
     PROPERTIES LABELS ${ARG_LABEL} TIMEOUT ${ARG_TIMEOUT}
                ENVIRONMENT "POSED_SOURCE_DIR=${PROJECT_SOURCE_DIR};POSED_BUILD_DIR=${PROJECT_BINARY_DIR}"

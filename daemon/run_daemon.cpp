@@ -209,7 +209,8 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
       line = status_line;
     }
     if (const auto message = pinger.poll(now, watchdog.check(now), line)) notifier.notify(*message);
-    if (now >= next_status_line) {
+    // While a stage stalls the pinger's STATUS= names it; ours would hide that.
+    if (now >= next_status_line && !pinger.reporting_stall()) {
       next_status_line = now + Duration::from_s(1);
       notifier.notify("STATUS=" + line);
     }

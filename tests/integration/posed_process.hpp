@@ -19,11 +19,11 @@ namespace posed::testing {
 
 inline std::string source_dir() {
   const char* s = std::getenv("POSED_SOURCE_DIR");
-  return s ? s : ".";
+  return s ? s : POSED_SOURCE_DIR_DEFAULT;
 }
 inline std::string build_dir() {
   const char* s = std::getenv("POSED_BUILD_DIR");
-  return s ? s : ".";
+  return s ? s : POSED_BUILD_DIR_DEFAULT;
 }
 
 /// A fresh directory under /tmp, removed with its files when the object dies.

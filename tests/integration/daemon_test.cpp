@@ -1,0 +1,196 @@
+// posed as a user runs it: a separate process on the synthetic IMU with the loopback DDS
+// profile, a separate DDS participant reading rt/posed/odom, a fake systemd notify socket, and
+// real signals.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "daemon/dds/subscriber.hpp"
+#include "tests/integration/notify_listener.hpp"
+#include "tests/integration/posed_process.hpp"
+
+namespace posed::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr double kRadius_m = 5.0;
+
+// A DDS domain of its own per test process, so parallel tests and a running demo never meet.
+int test_domain() { return 100 + static_cast<int>(::getpid() % 100); }
+
+std::string demo_like_config(const std::string& extra = "") {
+  return "dds:\n  domain_id: " + std::to_string(test_domain()) + "\n  cyclonedds_config: " +
+         source_dir() + "/config/cyclonedds-loopback.xml\n" +
+         "imu:\n  source: synthetic\n"
+         "synthetic_imu:\n  radius_m: 5\n  speed_mps: 1\n  static_s: 1.5\n  ramp_s: 2\n" +
+         extra + "estimator:\n  init_static_s: 0.5\n";
+}
+
+std::vector<std::string> posed_argv(const std::string& config_path) {
+  return {build_dir() + "/daemon/posed", "--config", config_path};
+}
+
+dds::DdsConfig reader_config() {
+  dds::DdsConfig c;
+  c.domain_id = static_cast<std::uint32_t>(test_domain());
+  c.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  return c;
+}
+
+TEST(Daemon, PublishesOdomThatFollowsTheKnownMotionAndStopsOnSigterm) {
+  TempDir dir;
+  const std::string config = dir.write("posed.yaml", demo_like_config());
+  std::string error;
+  const std::array topics = {dds::Topic::kOdom, dds::Topic::kStatus};
+  auto reader = dds::Subscriber::create(reader_config(), topics, error);
+  ASSERT_TRUE(reader) << error;
+
+  PosedProcess posed(posed_argv(config), {}, dir);
+  std::vector<dds::Received<dds::OdomMessage>> odom;
+  std::vector<dds::Received<dds::StatusMessage>> status;
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (odom.size() < 600 && std::chrono::steady_clock::now() < deadline) {
+    reader->wait(Duration::from_ms(100));
+    reader->take_odom(odom);
+    reader->take_status(status);
+  }
+  ASSERT_GE(odom.size(), 100u) << "stderr:\n" << posed.err();
+
+  // Every pose lies on the known circle (centre (0, R), level) with the heading of its tangent;
+  // before the motion starts, at the origin.
+  std::vector<double> latency_ms;
+  WallTime previous_stamp;
+  for (const auto& r : odom) {
+    const auto& m = r.msg;
+    EXPECT_EQ(r.frame_id, "map");
+    EXPECT_EQ(r.child_frame_id, "base_link");
+    EXPECT_GT(m.stamp, previous_stamp);
+    previous_stamp = m.stamp;
+    const Eigen::Vector3d p = m.p_map_base_m;
+    EXPECT_NEAR(p.z(), 0.0, 0.01);
+    const double from_centre = std::hypot(p.x(), p.y() - kRadius_m);
+    EXPECT_NEAR(from_centre, kRadius_m, 0.01) << p.transpose();
+    const double arc_angle = std::atan2(p.x(), kRadius_m - p.y());
+    const Eigen::Vector3d heading = m.q_map_base * Eigen::Vector3d::UnitX();
+    const double yaw = std::atan2(heading.y(), heading.x());
+    EXPECT_NEAR(std::remainder(yaw - arc_angle, 2 * M_PI), 0.0, 0.01);
+    EXPECT_NEAR(m.v_base_mps.y(), 0.0, 0.01);  // a car does not slide sideways
+    latency_ms.push_back((r.received_wall - m.stamp).seconds() * 1e3);
+  }
+  const double moved = odom.back().msg.p_map_base_m.norm();
+  EXPECT_GT(moved, 0.1) << "the last pose should be on its way round the circle";
+  std::sort(latency_ms.begin(), latency_ms.end());
+  EXPECT_LT(latency_ms[latency_ms.size() / 2], 50.0) << "median stamp-to-receive latency [ms]";
+
+  ASSERT_FALSE(status.empty());
+  EXPECT_EQ(status.back().msg.estimator_mode, "strapdown");
+  ASSERT_EQ(status.back().msg.streams.size(), 1u);
+  EXPECT_EQ(status.back().msg.streams[0].name, "imu");
+  EXPECT_EQ(status.back().msg.streams[0].health, "ok");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  posed.signal(SIGTERM);
+  const auto code = posed.wait_for_exit(2s);
+  ASSERT_TRUE(code.has_value()) << "posed did not exit within 2 s of SIGTERM";
+  EXPECT_EQ(*code, 0) << posed.err();
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
+  EXPECT_NE(posed.out().find("posed summary"), std::string::npos) << posed.out();
+}
+
+TEST(Daemon, TellsSystemdReadyThenFeedsTheWatchdogThenStopping) {
+  TempDir dir;
+  const std::string config = dir.write("posed.yaml", demo_like_config());
+  NotifyListener systemd("posed-test-notify-" + std::to_string(::getpid()));
+  PosedProcess posed(posed_argv(config), {systemd.env(), "WATCHDOG_USEC=300000"}, dir,
+                     /*set_watchdog_pid=*/true);
+
+  const auto first = systemd.collect(10s, "READY=1");
+  ASSERT_FALSE(first.empty()) << posed.err();
+  EXPECT_NE(first.back().text.find("READY=1"), std::string::npos);
+
+  const auto running = systemd.collect(1500ms);
+  const auto pings = std::count_if(running.begin(), running.end(), [](const auto& m) {
+    return m.text.find("WATCHDOG=1") != std::string::npos;
+  });
+  // WATCHDOG_USEC/2 = 150 ms: about 10 in 1.5 s.
+  EXPECT_GE(pings, 6) << "watchdog pings in 1.5 s";
+  EXPECT_TRUE(std::any_of(running.begin(), running.end(), [](const auto& m) {
+    return m.text.find("STATUS=") != std::string::npos;
+  }));
+
+  posed.signal(SIGTERM);
+  const auto stopping = systemd.collect(3s, "STOPPING=1");
+  ASSERT_FALSE(stopping.empty());
+  EXPECT_NE(stopping.back().text.find("STOPPING=1"), std::string::npos);
+  const auto code = posed.wait_for_exit(2s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0);
+}
+
+TEST(Daemon, WatchdogStopsWhenAStageStallsAndStatusNamesIt) {
+  TempDir dir;
+  // The fake IMU hangs in read() 2 s into its motion, like a stuck driver.
+  const std::string config = dir.write(
+      "posed.yaml", demo_like_config("  hang_after_s: 2\nwatchdog:\n  stage_deadline_s: 0.3\n"));
+  NotifyListener systemd("posed-test-stall-" + std::to_string(::getpid()));
+  PosedProcess posed(posed_argv(config), {systemd.env(), "WATCHDOG_USEC=200000"}, dir, true);
+
+  const auto messages = systemd.collect(5s);
+  const auto first_stall = std::find_if(messages.begin(), messages.end(), [](const auto& m) {
+    return m.text.find("imu_source") != std::string::npos;
+  });
+  ASSERT_NE(first_stall, messages.end()) << "no STATUS= naming the stalled stage; stderr:\n"
+                                         << posed.err();
+  const auto pings_before = std::count_if(messages.begin(), first_stall, [](const auto& m) {
+    return m.text.find("WATCHDOG=1") != std::string::npos;
+  });
+  const auto pings_after = std::count_if(first_stall, messages.end(), [](const auto& m) {
+    return m.text.find("WATCHDOG=1") != std::string::npos;
+  });
+  EXPECT_GE(pings_before, 5) << "the watchdog was fed while every stage ran";
+  EXPECT_EQ(pings_after, 0) << "WATCHDOG=1 must stop while a stage is stalled";
+
+  posed.signal(SIGTERM);
+  const auto code = posed.wait_for_exit(2s);
+  ASSERT_TRUE(code.has_value()) << "a stalled source must still stop on SIGTERM";
+  EXPECT_EQ(*code, 0);
+}
+
+TEST(Daemon, BadConfigStopsStartupNamingFileLineAndKey) {
+  TempDir dir;
+  const std::string config = dir.write("bad.yaml", "imu:\n  rate_hz: 5000\n  sourse: serial\n");
+  PosedProcess posed(posed_argv(config), {}, dir);
+  const auto code = posed.wait_for_exit(5s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 2);
+  EXPECT_NE(posed.err().find(config + ":2:12: imu.rate_hz: 5000 is out of range [1, 2000] Hz"),
+            std::string::npos)
+      << posed.err();
+  EXPECT_NE(posed.err().find(config + ":3:3: imu.sourse: unknown key (did you mean 'imu.source'?)"),
+            std::string::npos)
+      << posed.err();
+}
+
+TEST(Daemon, HelpAndPrintConfig) {
+  TempDir dir;
+  {
+    PosedProcess posed({build_dir() + "/daemon/posed", "--help"}, {}, dir);
+    ASSERT_EQ(posed.wait_for_exit(5s), 0);
+    EXPECT_NE(posed.out().find("--print-config"), std::string::npos);
+  }
+  {
+    PosedProcess posed({build_dir() + "/daemon/posed", "--print-config", "--config",
+                        source_dir() + "/config/posed.yaml"},
+                       {}, dir);
+    ASSERT_EQ(posed.wait_for_exit(5s), 0);
+    EXPECT_NE(posed.out().find("gravity_mps2: 9.805  # [m/s^2]"), std::string::npos)
+        << posed.out();
+  }
+}
+
+}  // namespace
+}  // namespace posed::testing
