@@ -12,6 +12,10 @@ std::span<const Benchmark> benchmarks() {
   static const std::array kBenchmarks = {
       Benchmark{"queue", "SPSC queue: 64-byte items between two threads, throughput and latency",
                 bench_queue},
+      Benchmark{"imu", "A9 parser throughput; serial pty write -> decoded sample latency", bench_imu},
+      Benchmark{"sync", "ClockSync: stamp error, re-lock and cost on simulated sensor clocks", bench_sync},
+      Benchmark{"velodyne", "Velodyne decode rate and loopback UDP receive at 15k packets/s", bench_velodyne},
+      Benchmark{"dds", "DDS odom 400 Hz publish -> receive latency, two participants, loopback", bench_dds},
   };
   return kBenchmarks;
 }

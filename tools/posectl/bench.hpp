@@ -27,5 +27,9 @@ struct Benchmark {
 std::span<const Benchmark> benchmarks();
 
 int bench_queue();
+int bench_imu();
+int bench_sync();
+int bench_velodyne();
+int bench_dds();
 
 }  // namespace posed::posectl

@@ -16,5 +16,8 @@ struct Command {
 std::span<const Command> commands();
 
 int run_bench(int argc, char** argv);
+int run_inspect(int argc, char** argv);
+int run_inspect_velodyne(int argc, char** argv);
+int run_echo(int argc, char** argv);
 
 }  // namespace posed::posectl

@@ -1,0 +1,143 @@
+#include "daemon/dds/convert.hpp"
+
+#include <algorithm>
+
+namespace posed::dds::detail {
+namespace {
+
+constexpr std::int64_t kNsPerS = 1'000'000'000;
+
+/// Cyclone reads the sample during dds_write only; it never writes through these pointers.
+char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }
+
+geometry_msgs_msg_dds__Point_ to_point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+geometry_msgs_msg_dds__Vector3_ to_vector(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+geometry_msgs_msg_dds__Quaternion_ to_quaternion(const Eigen::Quaterniond& q) {
+  return {q.x(), q.y(), q.z(), q.w()};
+}
+Eigen::Vector3d from_point(const geometry_msgs_msg_dds__Point_& p) { return {p.x, p.y, p.z}; }
+Eigen::Vector3d from_vector(const geometry_msgs_msg_dds__Vector3_& v) { return {v.x, v.y, v.z}; }
+Eigen::Quaterniond from_quaternion(const geometry_msgs_msg_dds__Quaternion_& q) {
+  return Eigen::Quaterniond(q.w, q.x, q.y, q.z);  // Eigen's constructor takes w first
+}
+
+}  // namespace
+
+builtin_interfaces_msg_dds__Time_ to_ros_time(WallTime stamp) {
+  std::int64_t sec = stamp.ns / kNsPerS;
+  std::int64_t nanosec = stamp.ns % kNsPerS;
+  if (nanosec < 0) {  // ROS keeps nanosec positive: -0.5 s is sec -1, nanosec 5e8
+    nanosec += kNsPerS;
+    sec -= 1;
+  }
+  return {static_cast<std::int32_t>(sec), static_cast<std::uint32_t>(nanosec)};
+}
+
+WallTime from_ros_time(const builtin_interfaces_msg_dds__Time_& time) {
+  return WallTime::from_ns(static_cast<std::int64_t>(time.sec) * kNsPerS +
+                           static_cast<std::int64_t>(time.nanosec));
+}
+
+void fill_odom(const OdomMessage& msg, nav_msgs_msg_dds__Odometry_& out) {
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.pose.pose.position = to_point(msg.p_map_base_m);
+  out.pose.pose.orientation = to_quaternion(msg.q_map_base);
+  std::copy(msg.pose_covariance.begin(), msg.pose_covariance.end(), out.pose.covariance);
+  out.twist.twist.linear = to_vector(msg.v_base_mps);
+  out.twist.twist.angular = to_vector(msg.w_base_radps);
+  std::copy(msg.twist_covariance.begin(), msg.twist_covariance.end(), out.twist.covariance);
+}
+
+void fill_pose(const PoseMessage& msg, geometry_msgs_msg_dds__PoseStamped_& out) {
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.pose.position = to_point(msg.p_map_base_m);
+  out.pose.orientation = to_quaternion(msg.q_map_base);
+}
+
+void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
+                 std::vector<posed_msgs_msg_dds__StreamStatus_>& streams) {
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.version = c_str(msg.version);
+  out.estimator_mode = c_str(msg.estimator_mode);
+  out.uptime_s = msg.uptime_s;
+  out.summary = c_str(msg.summary);
+  if (streams.size() < msg.streams.size()) streams.resize(msg.streams.size());
+  for (std::size_t i = 0; i < msg.streams.size(); ++i) {
+    const StreamStatusMessage& s = msg.streams[i];
+    posed_msgs_msg_dds__StreamStatus_& d = streams[i];
+    d.name = c_str(s.name);
+    d.rate_hz = s.rate_hz;
+    d.received = s.received;
+    d.decoded = s.decoded;
+    d.dropped = s.dropped;
+    d.malformed = s.malformed;
+    d.clock_offset_ns = s.clock_offset_ns;
+    d.clock_drift_ppm = s.clock_drift_ppm;
+    d.clock_jitter_ns = s.clock_jitter_ns;
+    d.clock_uncertainty_ns = s.clock_uncertainty_ns;
+    d.clock_state = c_str(s.clock_state);
+    d.health = c_str(s.health);
+  }
+  out.streams._buffer = streams.data();
+  out.streams._length = static_cast<std::uint32_t>(msg.streams.size());
+  out.streams._maximum = static_cast<std::uint32_t>(streams.size());
+  out.streams._release = false;  // the buffer belongs to the caller, not to Cyclone
+}
+
+OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in) {
+  OdomMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  msg.p_map_base_m = from_point(in.pose.pose.position);
+  msg.q_map_base = from_quaternion(in.pose.pose.orientation);
+  std::copy(std::begin(in.pose.covariance), std::end(in.pose.covariance),
+            msg.pose_covariance.begin());
+  msg.v_base_mps = from_vector(in.twist.twist.linear);
+  msg.w_base_radps = from_vector(in.twist.twist.angular);
+  std::copy(std::begin(in.twist.covariance), std::end(in.twist.covariance),
+            msg.twist_covariance.begin());
+  return msg;
+}
+
+PoseMessage to_plain(const geometry_msgs_msg_dds__PoseStamped_& in) {
+  PoseMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  msg.p_map_base_m = from_point(in.pose.position);
+  msg.q_map_base = from_quaternion(in.pose.orientation);
+  return msg;
+}
+
+StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
+  StatusMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  msg.version = to_string(in.version);
+  msg.estimator_mode = to_string(in.estimator_mode);
+  msg.uptime_s = in.uptime_s;
+  msg.summary = to_string(in.summary);
+  msg.streams.reserve(in.streams._length);
+  for (std::uint32_t i = 0; i < in.streams._length; ++i) {
+    const posed_msgs_msg_dds__StreamStatus_& s = in.streams._buffer[i];
+    StreamStatusMessage d;
+    d.name = to_string(s.name);
+    d.rate_hz = s.rate_hz;
+    d.received = s.received;
+    d.decoded = s.decoded;
+    d.dropped = s.dropped;
+    d.malformed = s.malformed;
+    d.clock_offset_ns = s.clock_offset_ns;
+    d.clock_drift_ppm = s.clock_drift_ppm;
+    d.clock_jitter_ns = s.clock_jitter_ns;
+    d.clock_uncertainty_ns = s.clock_uncertainty_ns;
+    d.clock_state = to_string(s.clock_state);
+    d.health = to_string(s.health);
+    msg.streams.push_back(std::move(d));
+  }
+  return msg;
+}
+
+std::string to_string(const char* text) {
+  return text != nullptr ? std::string(text) : std::string();
+}
+
+}  // namespace posed::dds::detail

@@ -1,0 +1,33 @@
+#pragma once
+// Internal to daemon/dds (and its tests): plain message structs <-> idlc-generated C samples.
+// The fill_* functions write only what the plain struct carries; header.frame_id and
+// child_frame_id belong to the Publisher, which fixes them at creation.
+
+#include <string>
+#include <vector>
+
+#include "daemon/dds/generated_types.hpp"
+#include "daemon/dds/messages.hpp"
+
+namespace posed::dds::detail {
+
+/// Wall time [ns since epoch] -> ROS Time (sec floor, 0 <= nanosec < 1e9).
+builtin_interfaces_msg_dds__Time_ to_ros_time(WallTime stamp);
+WallTime from_ros_time(const builtin_interfaces_msg_dds__Time_& time);
+
+void fill_odom(const OdomMessage& msg, nav_msgs_msg_dds__Odometry_& out);
+void fill_pose(const PoseMessage& msg, geometry_msgs_msg_dds__PoseStamped_& out);
+
+/// Points out's strings into `msg` (valid while msg lives, unchanged) and its stream sequence
+/// into `streams`, which grows only when a message has more streams than ever before.
+void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
+                 std::vector<posed_msgs_msg_dds__StreamStatus_>& streams);
+
+OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in);
+PoseMessage to_plain(const geometry_msgs_msg_dds__PoseStamped_& in);
+StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in);
+
+/// A C string field as std::string (Cyclone leaves unset strings null).
+std::string to_string(const char* text);
+
+}  // namespace posed::dds::detail

@@ -1,0 +1,137 @@
+#pragma once
+// What posed publishes over DDS, as plain C++ structs the daemon fills. They mirror the IDL in
+// daemon/dds/idl/ (ROS 2 nav_msgs/Odometry, geometry_msgs/PoseStamped, posed_msgs/Status) but do
+// not depend on the generated C code, so the pipeline never includes a DDS header.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/time.hpp"
+
+namespace posed::dds {
+
+/// The topics posed publishes.
+enum class Topic { kOdom, kPose, kStatus };
+
+/// DDS topic names: ROS 2 prefixes topics with "rt/", so ROS sees /posed/odom etc.
+inline constexpr std::string_view kOdomTopic = "rt/posed/odom";
+inline constexpr std::string_view kPoseTopic = "rt/posed/pose";
+inline constexpr std::string_view kStatusTopic = "rt/posed/status";
+
+/// The DDS topic name of `topic`, e.g. "rt/posed/odom".
+constexpr std::string_view topic_name(Topic topic) {
+  switch (topic) {
+    case Topic::kOdom:
+      return kOdomTopic;
+    case Topic::kPose:
+      return kPoseTopic;
+    case Topic::kStatus:
+      return kStatusTopic;
+  }
+  return {};
+}
+
+/// Accepts "odom", "/posed/odom" or "rt/posed/odom" (and likewise pose, status).
+constexpr bool parse_topic(std::string_view text, Topic& topic) {
+  for (Topic t : {Topic::kOdom, Topic::kPose, Topic::kStatus}) {
+    const std::string_view full = topic_name(t);  // "rt/posed/<short>"
+    const std::string_view ros = full.substr(2);  // "/posed/<short>"
+    const std::string_view short_name = full.substr(9);
+    if (text == full || text == ros || text == short_name) {
+      topic = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+/// nav_msgs/Odometry: pose of base in map, twist of base expressed in base (ROS convention).
+struct OdomMessage {
+  /// time the state refers to (wall clock, UNIX epoch) [ns]
+  WallTime stamp;
+  /// position of the base frame origin in the map frame [m]
+  Eigen::Vector3d p_map_base_m = Eigen::Vector3d::Zero();
+  /// orientation of the base frame in the map frame (rotates base vectors into map) [-]
+  Eigen::Quaterniond q_map_base = Eigen::Quaterniond::Identity();
+  /// linear velocity of the base, expressed in the base (child) frame [m/s]
+  Eigen::Vector3d v_base_mps = Eigen::Vector3d::Zero();
+  /// angular velocity of the base, expressed in the base (child) frame [rad/s]
+  Eigen::Vector3d w_base_radps = Eigen::Vector3d::Zero();
+  /// row-major 6x6 over (x, y, z, rot x, rot y, rot z) [m^2, m*rad, rad^2]
+  std::array<double, 36> pose_covariance{};
+  /// row-major 6x6 over (vx, vy, vz, wx, wy, wz) [(m/s)^2, m/s*rad/s, (rad/s)^2]
+  std::array<double, 36> twist_covariance{};
+};
+
+/// geometry_msgs/PoseStamped in the map frame.
+struct PoseMessage {
+  /// time the pose refers to (wall clock, UNIX epoch) [ns]
+  WallTime stamp;
+  /// position of the base frame origin in the map frame [m]
+  Eigen::Vector3d p_map_base_m = Eigen::Vector3d::Zero();
+  /// orientation of the base frame in the map frame [-]
+  Eigen::Quaterniond q_map_base = Eigen::Quaterniond::Identity();
+};
+
+/// posed_msgs/StreamStatus: health of one input stream.
+struct StreamStatusMessage {
+  /// stream name, e.g. "imu", "lidar"
+  std::string name;
+  /// measured arrival rate of decoded samples [Hz]
+  double rate_hz = 0.0;
+  /// samples received from the Source since start [count]
+  std::uint64_t received = 0;
+  /// samples decoded successfully since start [count]
+  std::uint64_t decoded = 0;
+  /// samples dropped by a queue's drop policy since start [count]
+  std::uint64_t dropped = 0;
+  /// samples the decoder rejected since start [count]
+  std::uint64_t malformed = 0;
+  /// host monotonic minus device clock, as estimated by ClockSync [ns]
+  std::int64_t clock_offset_ns = 0;
+  /// device clock rate error relative to the host clock [ppm]
+  double clock_drift_ppm = 0.0;
+  /// standard deviation of transport jitter around the clock model [ns]
+  double clock_jitter_ns = 0.0;
+  /// 1-sigma uncertainty of the mapped host time [ns]
+  double clock_uncertainty_ns = 0.0;
+  /// ClockSync state, e.g. "locked", "converging"
+  std::string clock_state;
+  /// overall verdict, e.g. "ok", "degraded", "stale"
+  std::string health;
+};
+
+/// posed_msgs/Status: published at 1 Hz.
+struct StatusMessage {
+  /// time of the report (wall clock, UNIX epoch) [ns]
+  WallTime stamp;
+  /// daemon version, e.g. "posed 0.1.0"
+  std::string version;
+  /// estimator mode, e.g. "strapdown"
+  std::string estimator_mode;
+  /// time since the daemon started [s]
+  double uptime_s = 0.0;
+  /// one-line human-readable summary
+  std::string summary;
+  /// one entry per input stream
+  std::vector<StreamStatusMessage> streams;
+};
+
+/// Where and how posed talks DDS (the `dds:` section of the daemon config).
+struct DdsConfig {
+  /// DDS domain (ROS_DOMAIN_ID) [-]
+  std::uint32_t domain_id = 0;
+  /// header.frame_id of odom, pose and status
+  std::string map_frame = "map";
+  /// child_frame_id of odom
+  std::string base_frame = "base_link";
+  /// Cyclone XML file used to create the domain; empty: CYCLONEDDS_URI or Cyclone's default.
+  std::string cyclonedds_xml_path;
+};
+
+}  // namespace posed::dds

@@ -1,0 +1,97 @@
+#include "daemon/dds/publisher.hpp"
+
+#include <atomic>
+#include <vector>
+
+#include "daemon/dds/convert.hpp"
+#include "daemon/dds/participant.hpp"
+
+namespace posed::dds {
+
+struct Publisher::Impl {
+  std::unique_ptr<detail::Participant> participant;
+  dds_entity_t odom_writer = 0;
+  dds_entity_t pose_writer = 0;
+  dds_entity_t status_writer = 0;
+  // Frame ids live here for the publisher's lifetime; the samples point into them.
+  std::string map_frame;
+  std::string base_frame;
+  nav_msgs_msg_dds__Odometry_ odom_sample{};
+  geometry_msgs_msg_dds__PoseStamped_ pose_sample{};
+  posed_msgs_msg_dds__Status_ status_sample{};
+  std::vector<posed_msgs_msg_dds__StreamStatus_> status_streams;
+  std::atomic<std::uint64_t> write_failures{0};
+
+  bool write(dds_entity_t writer, const void* sample) {
+    if (dds_write(writer, sample) == DDS_RETCODE_OK) return true;
+    write_failures.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+};
+
+std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::string& error) {
+  auto impl = std::make_unique<Impl>();
+  impl->participant = detail::Participant::open(config, error);
+  if (!impl->participant) return nullptr;
+  const dds_entity_t participant = impl->participant->handle();
+
+  dds_qos_t* qos = detail::make_topic_qos();
+  const auto make_writer = [&](Topic topic, dds_entity_t& writer) {
+    const dds_entity_t t = detail::create_topic(participant, topic, error);
+    if (t < 0) return false;
+    writer = dds_create_writer(participant, t, qos, nullptr);
+    if (writer < 0) {
+      error = detail::describe_error(std::string(topic_name(topic)) + ": create writer", writer);
+      return false;
+    }
+    return true;
+  };
+  const bool ok = make_writer(Topic::kOdom, impl->odom_writer) &&
+                  make_writer(Topic::kPose, impl->pose_writer) &&
+                  make_writer(Topic::kStatus, impl->status_writer);
+  dds_delete_qos(qos);
+  if (!ok) return nullptr;  // ~Participant deletes whatever was created
+
+  impl->map_frame = config.map_frame;
+  impl->base_frame = config.base_frame;
+  char* map_frame = impl->map_frame.data();
+  impl->odom_sample.header.frame_id = map_frame;
+  impl->odom_sample.child_frame_id = impl->base_frame.data();
+  impl->pose_sample.header.frame_id = map_frame;
+  impl->status_sample.header.frame_id = map_frame;
+  impl->status_streams.resize(8);  // posed has 4 sensors, some with 2 streams
+  return std::unique_ptr<Publisher>(new Publisher(std::move(impl)));
+}
+
+Publisher::Publisher(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Publisher::~Publisher() = default;
+
+bool Publisher::publish_odom(const OdomMessage& msg) {
+  detail::fill_odom(msg, impl_->odom_sample);
+  return impl_->write(impl_->odom_writer, &impl_->odom_sample);
+}
+
+bool Publisher::publish_pose(const PoseMessage& msg) {
+  detail::fill_pose(msg, impl_->pose_sample);
+  return impl_->write(impl_->pose_writer, &impl_->pose_sample);
+}
+
+bool Publisher::publish_status(const StatusMessage& msg) {
+  detail::fill_status(msg, impl_->status_sample, impl_->status_streams);
+  return impl_->write(impl_->status_writer, &impl_->status_sample);
+}
+
+std::uint32_t Publisher::matched_subscribers(Topic topic) const {
+  const dds_entity_t writer = topic == Topic::kOdom   ? impl_->odom_writer
+                              : topic == Topic::kPose ? impl_->pose_writer
+                                                      : impl_->status_writer;
+  dds_publication_matched_status_t status{};
+  if (dds_get_publication_matched_status(writer, &status) != DDS_RETCODE_OK) return 0;
+  return status.current_count;
+}
+
+std::uint64_t Publisher::write_failures() const {
+  return impl_->write_failures.load(std::memory_order_relaxed);
+}
+
+}  // namespace posed::dds

@@ -1,0 +1,43 @@
+#pragma once
+// posed's DDS output (DESIGN.md, DDS interface): nav_msgs/Odometry on rt/posed/odom,
+// geometry_msgs/PoseStamped on rt/posed/pose and posed_msgs/Status on rt/posed/status, with
+// ROS 2's DDS type names, so `ros2 topic echo /posed/odom` or any plain DDS reader receives them.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "daemon/dds/messages.hpp"
+
+namespace posed::dds {
+
+/// One DDS participant with a writer per topic. Publishing reuses preallocated samples (frame
+/// ids fixed at creation), so it allocates nothing beyond what Cyclone does per write.
+/// Thread-safety: each publish_* may run on its own thread, but one topic from one thread.
+class Publisher {
+ public:
+  /// nullptr with `error` set (naming the Cyclone XML file when one is configured) on failure.
+  static std::unique_ptr<Publisher> create(const DdsConfig& config, std::string& error);
+  ~Publisher();
+  Publisher(const Publisher&) = delete;
+  Publisher& operator=(const Publisher&) = delete;
+
+  /// false when Cyclone rejected the write (e.g. a reliable reader blocked it > 10 ms);
+  /// such failures are also counted in write_failures().
+  bool publish_odom(const OdomMessage& msg);
+  bool publish_pose(const PoseMessage& msg);
+  bool publish_status(const StatusMessage& msg);
+
+  /// Readers currently matched on `topic` [count]; samples before a match are not delivered
+  /// (volatile durability), so tests and benchmarks wait for this first.
+  std::uint32_t matched_subscribers(Topic topic) const;
+  /// Writes Cyclone rejected since creation [count].
+  std::uint64_t write_failures() const;
+
+ private:
+  struct Impl;
+  explicit Publisher(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace posed::dds

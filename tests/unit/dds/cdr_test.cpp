@@ -1,0 +1,323 @@
+// Every IDL type serialized to CDR by Cyclone and back, and the bytes of a PoseStamped_ checked
+// against a hand-computed little-endian layout: the wire format must be ROS 2's, since CDR is
+// positional and a ROS 2 reader decodes it without any type negotiation.
+
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "daemon/dds/generated_types.hpp"
+#include "daemon/dds/participant.hpp"
+#include "tests/unit/dds/test_domain.hpp"
+
+namespace posed::dds {
+namespace {
+
+/// A writer and a reader of one type in one participant: Cyclone serializes at dds_write and the
+/// reader hands back the serialized form (dds_takecdr), which is then decoded from raw bytes.
+class CdrLoop : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string error;
+    participant_ = detail::Participant::open(test::loopback_config(), error);
+    ASSERT_NE(participant_, nullptr) << error;
+  }
+
+  /// Serializes `in`, returns the CDR bytes (encapsulation header included) and decodes those
+  /// bytes into `out` (zero-initialised by the caller, freed with free_sample).
+  template <class T>
+  std::vector<unsigned char> round_trip(const dds_topic_descriptor_t& desc, const T& in, T& out) {
+    const dds_entity_t pp = participant_->handle();
+    std::string name = std::string("posed_test/") + desc.m_typename;
+    std::replace(name.begin(), name.end(), ':', '_');  // ':' is not allowed in topic names
+    dds_qos_t* qos = detail::make_topic_qos();
+    const dds_entity_t topic = dds_create_topic(pp, &desc, name.c_str(), qos, nullptr);
+    EXPECT_GT(topic, 0) << name << ": " << dds_strretcode(topic);
+    if (topic <= 0) return {};
+    const dds_entity_t reader = dds_create_reader(pp, topic, qos, nullptr);
+    const dds_entity_t writer = dds_create_writer(pp, topic, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(reader, 0);
+    EXPECT_GT(writer, 0);
+    EXPECT_EQ(dds_write(writer, &in), DDS_RETCODE_OK);
+
+    ddsi_serdata* written = nullptr;
+    dds_sample_info_t info{};
+    const bool got = test::eventually(
+        [&] { return dds_takecdr(reader, &written, 1, &info, DDS_ANY_STATE) == 1; });
+    EXPECT_TRUE(got) << name << ": nothing came back";
+    if (!got) return {};
+
+    std::vector<unsigned char> bytes(ddsi_serdata_size(written));
+    ddsi_serdata_to_ser(written, 0, bytes.size(), bytes.data());
+    // Decode from the bytes alone, as a remote reader would.
+    ddsrt_iovec_t iov{};
+    iov.iov_base = bytes.data();
+    iov.iov_len = static_cast<decltype(iov.iov_len)>(bytes.size());
+    ddsi_serdata* parsed =
+        ddsi_serdata_from_ser_iov(written->type, SDK_DATA, 1, &iov, bytes.size());
+    EXPECT_NE(parsed, nullptr);
+    if (parsed != nullptr) {
+      EXPECT_TRUE(ddsi_serdata_to_sample(parsed, &out, nullptr, nullptr));
+      ddsi_serdata_unref(parsed);
+    }
+    ddsi_serdata_unref(written);
+    dds_delete(writer);
+    dds_delete(reader);
+    dds_delete(topic);
+    return bytes;
+  }
+
+  template <class T>
+  static void free_sample(const dds_topic_descriptor_t& desc, T& sample) {
+    dds_sample_free(&sample, &desc, DDS_FREE_CONTENTS);
+  }
+
+  std::unique_ptr<detail::Participant> participant_;
+};
+
+/// Little-endian CDR writer for the expected bytes; alignment is relative to the payload start
+/// (after the 4-byte encapsulation header), as in XCDR1.
+struct CdrBuilder {
+  std::vector<unsigned char> bytes{0x00, 0x01, 0x00, 0x00};  // CDR_LE, options 0
+  void align(std::size_t n) {
+    while ((bytes.size() - 4) % n != 0) bytes.push_back(0);
+  }
+  template <class T>
+  void put(T value) {
+    align(sizeof(T));
+    unsigned char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));  // the test host is little-endian (x86-64, arm64)
+    bytes.insert(bytes.end(), raw, raw + sizeof(T));
+  }
+  void put_string(const std::string& s) {
+    put(static_cast<std::uint32_t>(s.size() + 1));  // length counts the terminating NUL
+    bytes.insert(bytes.end(), s.begin(), s.end());
+    bytes.push_back(0);
+  }
+};
+
+TEST_F(CdrLoop, PoseStampedBytesMatchRos2Layout) {
+  char frame[] = "world";  // 6 bytes with NUL: forces 2 bytes of padding before the doubles
+  geometry_msgs_msg_dds__PoseStamped_ in{};
+  in.header.stamp = {1'700'000'000, 123'456'789};
+  in.header.frame_id = frame;
+  in.pose.position = {1.5, -2.25, 3.125};
+  in.pose.orientation = {0.1, 0.2, 0.3, 0.9};
+  geometry_msgs_msg_dds__PoseStamped_ out{};
+  const auto bytes = round_trip(geometry_msgs_msg_dds__PoseStamped__desc, in, out);
+
+  CdrBuilder expected;
+  expected.put<std::int32_t>(1'700'000'000);
+  expected.put<std::uint32_t>(123'456'789);
+  expected.put_string("world");
+  for (double v : {1.5, -2.25, 3.125, 0.1, 0.2, 0.3, 0.9}) expected.put(v);
+  ASSERT_EQ(expected.bytes.size(), 4u + 80u);  // 4 + 4 + 4 + 6 + 2 pad + 7 * 8
+  EXPECT_EQ(bytes, expected.bytes);
+
+  EXPECT_EQ(out.header.stamp.sec, 1'700'000'000);
+  EXPECT_EQ(out.header.stamp.nanosec, 123'456'789u);
+  EXPECT_STREQ(out.header.frame_id, "world");
+  EXPECT_EQ(out.pose.position.y, -2.25);
+  EXPECT_EQ(out.pose.orientation.w, 0.9);
+  free_sample(geometry_msgs_msg_dds__PoseStamped__desc, out);
+}
+
+TEST_F(CdrLoop, TimeBytesAreSecThenNanosec) {
+  builtin_interfaces_msg_dds__Time_ in{-5, 999'999'999};
+  builtin_interfaces_msg_dds__Time_ out{};
+  const auto bytes = round_trip(builtin_interfaces_msg_dds__Time__desc, in, out);
+  CdrBuilder expected;
+  expected.put<std::int32_t>(-5);
+  expected.put<std::uint32_t>(999'999'999);
+  EXPECT_EQ(bytes, expected.bytes);
+  EXPECT_EQ(out.sec, -5);
+  EXPECT_EQ(out.nanosec, 999'999'999u);
+}
+
+TEST_F(CdrLoop, HeaderRoundTrips) {
+  char frame[] = "map";
+  std_msgs_msg_dds__Header_ in{{7, 8}, frame};
+  std_msgs_msg_dds__Header_ out{};
+  const auto bytes = round_trip(std_msgs_msg_dds__Header__desc, in, out);
+  CdrBuilder expected;
+  expected.put<std::int32_t>(7);
+  expected.put<std::uint32_t>(8);
+  expected.put_string("map");
+  EXPECT_EQ(bytes, expected.bytes);
+  EXPECT_EQ(out.stamp.sec, 7);
+  EXPECT_EQ(out.stamp.nanosec, 8u);
+  EXPECT_STREQ(out.frame_id, "map");
+  free_sample(std_msgs_msg_dds__Header__desc, out);
+}
+
+/// Types without strings or sequences round-trip bit for bit (memcmp is exact: no padding
+/// inside these all-double structs).
+template <class T>
+void expect_same_bits(const T& a, const T& b) {
+  EXPECT_EQ(std::memcmp(&a, &b, sizeof(T)), 0);
+}
+
+TEST_F(CdrLoop, GeometryTypesRoundTrip) {
+  {
+    geometry_msgs_msg_dds__Point_ in{1.0, -2.0, 1e-300}, out{};
+    const auto bytes = round_trip(geometry_msgs_msg_dds__Point__desc, in, out);
+    EXPECT_EQ(bytes.size(), 4u + 24u);
+    expect_same_bits(in, out);
+  }
+  {
+    geometry_msgs_msg_dds__Quaternion_ in{0.5, -0.5, 0.5, -0.5}, out{};
+    const auto bytes = round_trip(geometry_msgs_msg_dds__Quaternion__desc, in, out);
+    EXPECT_EQ(bytes.size(), 4u + 32u);
+    expect_same_bits(in, out);
+  }
+  {
+    geometry_msgs_msg_dds__Pose_ in{{1, 2, 3}, {4, 5, 6, 7}}, out{};
+    const auto bytes = round_trip(geometry_msgs_msg_dds__Pose__desc, in, out);
+    CdrBuilder expected;
+    for (double v : {1, 2, 3, 4, 5, 6, 7}) expected.put(v);  // position then x y z w
+    EXPECT_EQ(bytes, expected.bytes);
+    expect_same_bits(in, out);
+  }
+  {
+    geometry_msgs_msg_dds__PoseWithCovariance_ in{}, out{};
+    in.pose = {{1, 2, 3}, {0, 0, 0, 1}};
+    for (int i = 0; i < 36; ++i) in.covariance[i] = 0.01 * i;
+    const auto bytes = round_trip(geometry_msgs_msg_dds__PoseWithCovariance__desc, in, out);
+    EXPECT_EQ(bytes.size(), 4u + (7u + 36u) * 8u);
+    expect_same_bits(in, out);
+  }
+  {
+    geometry_msgs_msg_dds__Vector3_ in{-1, 0.25, 9}, out{};
+    round_trip(geometry_msgs_msg_dds__Vector3__desc, in, out);
+    expect_same_bits(in, out);
+  }
+  {
+    geometry_msgs_msg_dds__Twist_ in{{1, 2, 3}, {-4, -5, -6}}, out{};
+    const auto bytes = round_trip(geometry_msgs_msg_dds__Twist__desc, in, out);
+    EXPECT_EQ(bytes.size(), 4u + 48u);
+    expect_same_bits(in, out);
+  }
+  {
+    geometry_msgs_msg_dds__TwistWithCovariance_ in{}, out{};
+    in.twist = {{1, 2, 3}, {4, 5, 6}};
+    for (int i = 0; i < 36; ++i) in.covariance[i] = -0.5 * i;
+    const auto bytes = round_trip(geometry_msgs_msg_dds__TwistWithCovariance__desc, in, out);
+    EXPECT_EQ(bytes.size(), 4u + (6u + 36u) * 8u);
+    expect_same_bits(in, out);
+  }
+}
+
+TEST_F(CdrLoop, OdometryRoundTripsWithRos2FieldOrder) {
+  char frame[] = "map";
+  char child[] = "base_link";
+  nav_msgs_msg_dds__Odometry_ in{};
+  in.header = {{100, 200}, frame};
+  in.child_frame_id = child;
+  in.pose.pose = {{1, 2, 3}, {0, 0, 0.6, 0.8}};
+  in.twist.twist = {{0.5, 0, 0}, {0, 0, 0.1}};
+  for (int i = 0; i < 36; ++i) {
+    in.pose.covariance[i] = i;
+    in.twist.covariance[i] = 100 + i;
+  }
+  nav_msgs_msg_dds__Odometry_ out{};
+  const auto bytes = round_trip(nav_msgs_msg_dds__Odometry__desc, in, out);
+
+  CdrBuilder expected;  // header, child_frame_id, pose (+cov), twist (+cov)
+  expected.put<std::int32_t>(100);
+  expected.put<std::uint32_t>(200);
+  expected.put_string("map");
+  expected.put_string("base_link");
+  for (double v : {1.0, 2.0, 3.0, 0.0, 0.0, 0.6, 0.8}) expected.put(v);
+  for (int i = 0; i < 36; ++i) expected.put(static_cast<double>(i));
+  for (double v : {0.5, 0.0, 0.0, 0.0, 0.0, 0.1}) expected.put(v);
+  for (int i = 0; i < 36; ++i) expected.put(static_cast<double>(100 + i));
+  EXPECT_EQ(bytes, expected.bytes);
+
+  EXPECT_STREQ(out.header.frame_id, "map");
+  EXPECT_STREQ(out.child_frame_id, "base_link");
+  EXPECT_EQ(out.pose.pose.orientation.z, 0.6);
+  EXPECT_EQ(out.twist.twist.angular.z, 0.1);
+  EXPECT_EQ(out.pose.covariance[35], 35.0);
+  EXPECT_EQ(out.twist.covariance[0], 100.0);
+  free_sample(nav_msgs_msg_dds__Odometry__desc, out);
+}
+
+posed_msgs_msg_dds__StreamStatus_ make_stream(char* name, char* state, char* health, double k) {
+  posed_msgs_msg_dds__StreamStatus_ s{};
+  s.name = name;
+  s.rate_hz = 400.0 * k;
+  s.received = 1000 + static_cast<std::uint64_t>(k);
+  s.decoded = 999;
+  s.dropped = 1;
+  s.malformed = 2;
+  s.clock_offset_ns = -123'456'789'012;
+  s.clock_drift_ppm = 12.5;
+  s.clock_jitter_ns = 3000.0;
+  s.clock_uncertainty_ns = 150.0;
+  s.clock_state = state;
+  s.health = health;
+  return s;
+}
+
+void expect_stream_eq(const posed_msgs_msg_dds__StreamStatus_& a,
+                      const posed_msgs_msg_dds__StreamStatus_& b) {
+  EXPECT_STREQ(a.name, b.name);
+  EXPECT_EQ(a.rate_hz, b.rate_hz);
+  EXPECT_EQ(a.received, b.received);
+  EXPECT_EQ(a.decoded, b.decoded);
+  EXPECT_EQ(a.dropped, b.dropped);
+  EXPECT_EQ(a.malformed, b.malformed);
+  EXPECT_EQ(a.clock_offset_ns, b.clock_offset_ns);
+  EXPECT_EQ(a.clock_drift_ppm, b.clock_drift_ppm);
+  EXPECT_EQ(a.clock_jitter_ns, b.clock_jitter_ns);
+  EXPECT_EQ(a.clock_uncertainty_ns, b.clock_uncertainty_ns);
+  EXPECT_STREQ(a.clock_state, b.clock_state);
+  EXPECT_STREQ(a.health, b.health);
+}
+
+TEST_F(CdrLoop, StreamStatusRoundTrips) {
+  char name[] = "imu", state[] = "locked", health[] = "ok";
+  auto in = make_stream(name, state, health, 1.0);
+  posed_msgs_msg_dds__StreamStatus_ out{};
+  round_trip(posed_msgs_msg_dds__StreamStatus__desc, in, out);
+  expect_stream_eq(in, out);
+  free_sample(posed_msgs_msg_dds__StreamStatus__desc, out);
+}
+
+TEST_F(CdrLoop, StatusRoundTripsWithStreams) {
+  char frame[] = "map", version[] = "posed 0.1.0", mode[] = "strapdown", summary[] = "2 streams";
+  char imu[] = "imu", lidar[] = "lidar", locked[] = "locked", conv[] = "converging";
+  char ok[] = "ok", degraded[] = "degraded";
+  posed_msgs_msg_dds__StreamStatus_ streams[2] = {make_stream(imu, locked, ok, 1.0),
+                                                  make_stream(lidar, conv, degraded, 2.0)};
+  posed_msgs_msg_dds__Status_ in{};
+  in.header = {{1, 2}, frame};
+  in.version = version;
+  in.estimator_mode = mode;
+  in.uptime_s = 3600.25;
+  in.summary = summary;
+  in.streams._buffer = streams;
+  in.streams._length = 2;
+  in.streams._maximum = 2;
+  in.streams._release = false;
+  posed_msgs_msg_dds__Status_ out{};
+  round_trip(posed_msgs_msg_dds__Status__desc, in, out);
+  EXPECT_STREQ(out.header.frame_id, "map");
+  EXPECT_STREQ(out.version, "posed 0.1.0");
+  EXPECT_STREQ(out.estimator_mode, "strapdown");
+  EXPECT_EQ(out.uptime_s, 3600.25);
+  EXPECT_STREQ(out.summary, "2 streams");
+  ASSERT_EQ(out.streams._length, 2u);
+  expect_stream_eq(out.streams._buffer[0], streams[0]);
+  expect_stream_eq(out.streams._buffer[1], streams[1]);
+  free_sample(posed_msgs_msg_dds__Status__desc, out);
+}
+
+}  // namespace
+}  // namespace posed::dds

@@ -1,0 +1,335 @@
+// posectl echo: subscribes to one of posed's DDS topics and prints each sample with units (or as
+// CSV), plus the receive rate [Hz] and stamp-to-receive latency [ms] once a second and at exit.
+// Latency is wall clock at receipt minus the message stamp, so it includes the daemon's own
+// processing delay (stamp = measurement time), not just DDS transport.
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "daemon/dds/subscriber.hpp"
+#include "drivers/common/host_clock.hpp"
+#include "tools/posectl/commands.hpp"
+
+namespace posed::posectl {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted.store(true); }
+
+double yaw_deg(const Eigen::Quaterniond& q) {
+  const double yaw = std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()),
+                                1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+  return yaw * 180.0 / M_PI;
+}
+
+/// "1700000000.123456789" [s] from a wall stamp.
+std::string stamp_text(WallTime t) {
+  std::int64_t s = t.ns / 1'000'000'000;
+  std::int64_t ns = t.ns % 1'000'000'000;
+  if (ns < 0) {
+    ns += 1'000'000'000;
+    s -= 1;
+  }
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%lld.%09lld", static_cast<long long>(s),
+                static_cast<long long>(ns));
+  return buf;
+}
+
+/// CSV field: quoted when it holds a comma, quote or newline (RFC 4180).
+std::string csv(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return NAN;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(p * static_cast<double>(values.size() - 1) + 0.5)];
+}
+
+/// Receive rate and latency, over the window since the last report and over the whole run.
+struct EchoStats {
+  std::vector<double> latency_ms_all;
+  std::size_t window_start = 0;  ///< index into latency_ms_all where the window starts
+  HostTime first_receive{};
+  HostTime last_receive{};
+  HostTime window_begin{};
+
+  void add(WallTime stamp, WallTime received_wall, HostTime received_host) {
+    if (latency_ms_all.empty()) first_receive = received_host;
+    last_receive = received_host;
+    latency_ms_all.push_back((received_wall - stamp).seconds() * 1e3);
+  }
+  std::size_t count() const { return latency_ms_all.size(); }
+
+  /// One line of rate and latency over the window ending `now`; starts the next window.
+  void report_window(std::FILE* out, const char* topic, HostTime now, std::uint32_t publishers) {
+    const std::size_t n = latency_ms_all.size() - window_start;
+    const double seconds = (now - window_begin).seconds();
+    if (n == 0) {
+      std::fprintf(out, "# %s: no samples in %.1f s (matched publishers: %u)\n", topic, seconds,
+                   publishers);
+    } else {
+      std::vector<double> window(latency_ms_all.begin() + static_cast<std::ptrdiff_t>(window_start),
+                                 latency_ms_all.end());
+      std::fprintf(out, "# %s: %.1f Hz, latency p50 %.3f ms p99 %.3f ms (%zu samples in %.1f s)\n",
+                   topic, static_cast<double>(n) / seconds, percentile(window, 0.50),
+                   percentile(window, 0.99), n, seconds);
+    }
+    std::fflush(out);
+    window_start = latency_ms_all.size();
+    window_begin = now;
+  }
+
+  void report_summary(std::FILE* out, const char* topic) const {
+    if (count() == 0) {
+      std::fprintf(out, "# summary %s: 0 samples\n", topic);
+      std::fflush(out);
+      return;
+    }
+    const double span = (last_receive - first_receive).seconds();
+    const double rate = count() >= 2 && span > 0 ? static_cast<double>(count() - 1) / span : 0.0;
+    std::fprintf(
+        out,
+        "# summary %s: %zu samples, rate %.2f Hz, latency p50 %.3f ms p99 %.3f ms "
+        "max %.3f ms\n",
+        topic, count(), rate, percentile(latency_ms_all, 0.50), percentile(latency_ms_all, 0.99),
+        latency_ms_all.empty() ? NAN
+                               : *std::max_element(latency_ms_all.begin(), latency_ms_all.end()));
+    std::fflush(out);
+  }
+};
+
+void print_odom_header_csv() {
+  std::printf(
+      "stamp_s,receive_s,latency_ms,frame_id,child_frame_id,x_m,y_m,z_m,qx,qy,qz,qw,yaw_deg,"
+      "vx_mps,vy_mps,vz_mps,wx_radps,wy_radps,wz_radps\n");
+}
+
+void print_odom(const dds::Received<dds::OdomMessage>& r, bool as_csv) {
+  const auto& m = r.msg;
+  const auto& p = m.p_map_base_m;
+  const auto& q = m.q_map_base;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  if (as_csv) {
+    std::printf(
+        "%s,%s,%.3f,%s,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,"
+        "%.6f\n",
+        stamp_text(m.stamp).c_str(), stamp_text(r.received_wall).c_str(), lat,
+        csv(r.frame_id).c_str(), csv(r.child_frame_id).c_str(), p.x(), p.y(), p.z(), q.x(), q.y(),
+        q.z(), q.w(), yaw_deg(q), m.v_base_mps.x(), m.v_base_mps.y(), m.v_base_mps.z(),
+        m.w_base_radps.x(), m.w_base_radps.y(), m.w_base_radps.z());
+    return;
+  }
+  std::printf(
+      "odom %s s %s->%s  p [%.3f %.3f %.3f] m  q(xyzw) [%.4f %.4f %.4f %.4f] yaw %.2f deg  "
+      "v [%.3f %.3f %.3f] m/s  w [%.3f %.3f %.3f] rad/s  latency %.3f ms\n",
+      stamp_text(m.stamp).c_str(), r.frame_id.c_str(), r.child_frame_id.c_str(), p.x(), p.y(),
+      p.z(), q.x(), q.y(), q.z(), q.w(), yaw_deg(q), m.v_base_mps.x(), m.v_base_mps.y(),
+      m.v_base_mps.z(), m.w_base_radps.x(), m.w_base_radps.y(), m.w_base_radps.z(), lat);
+}
+
+void print_pose_header_csv() {
+  std::printf("stamp_s,receive_s,latency_ms,frame_id,x_m,y_m,z_m,qx,qy,qz,qw,yaw_deg\n");
+}
+
+void print_pose(const dds::Received<dds::PoseMessage>& r, bool as_csv) {
+  const auto& m = r.msg;
+  const auto& p = m.p_map_base_m;
+  const auto& q = m.q_map_base;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  if (as_csv) {
+    std::printf("%s,%s,%.3f,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%.3f\n",
+                stamp_text(m.stamp).c_str(), stamp_text(r.received_wall).c_str(), lat,
+                csv(r.frame_id).c_str(), p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w(),
+                yaw_deg(q));
+    return;
+  }
+  std::printf(
+      "pose %s s in %s  p [%.3f %.3f %.3f] m  q(xyzw) [%.4f %.4f %.4f %.4f] yaw %.2f deg  "
+      "latency %.3f ms\n",
+      stamp_text(m.stamp).c_str(), r.frame_id.c_str(), p.x(), p.y(), p.z(), q.x(), q.y(), q.z(),
+      q.w(), yaw_deg(q), lat);
+}
+
+void print_status_header_csv() {
+  std::printf(
+      "stamp_s,receive_s,latency_ms,version,estimator_mode,uptime_s,summary,stream,rate_hz,"
+      "received,decoded,dropped,malformed,clock_offset_ns,clock_drift_ppm,clock_jitter_ns,"
+      "clock_uncertainty_ns,clock_state,health\n");
+}
+
+void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
+  const auto& m = r.msg;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  if (as_csv) {
+    // One row per stream (a status without streams still gets one row).
+    const std::string prefix = stamp_text(m.stamp) + "," + stamp_text(r.received_wall) + "," +
+                               std::to_string(lat) + "," + csv(m.version) + "," +
+                               csv(m.estimator_mode) + "," + std::to_string(m.uptime_s) + "," +
+                               csv(m.summary);
+    if (m.streams.empty()) std::printf("%s,,,,,,,,,,,,\n", prefix.c_str());
+    for (const auto& s : m.streams) {
+      std::printf("%s,%s,%.3f,%llu,%llu,%llu,%llu,%lld,%.3f,%.1f,%.1f,%s,%s\n", prefix.c_str(),
+                  csv(s.name).c_str(), s.rate_hz, static_cast<unsigned long long>(s.received),
+                  static_cast<unsigned long long>(s.decoded),
+                  static_cast<unsigned long long>(s.dropped),
+                  static_cast<unsigned long long>(s.malformed),
+                  static_cast<long long>(s.clock_offset_ns), s.clock_drift_ppm, s.clock_jitter_ns,
+                  s.clock_uncertainty_ns, csv(s.clock_state).c_str(), csv(s.health).c_str());
+    }
+    return;
+  }
+  std::printf("status %s s  %s  mode %s  uptime %.1f s  latency %.3f ms  %s\n",
+              stamp_text(m.stamp).c_str(), m.version.c_str(), m.estimator_mode.c_str(), m.uptime_s,
+              lat, m.summary.c_str());
+  for (const auto& s : m.streams) {
+    std::printf(
+        "  %-10s %8.2f Hz  received %llu decoded %llu dropped %llu malformed %llu  clock %s: "
+        "offset %lld ns drift %.3f ppm jitter %.0f ns uncertainty %.0f ns  health %s\n",
+        s.name.c_str(), s.rate_hz, static_cast<unsigned long long>(s.received),
+        static_cast<unsigned long long>(s.decoded), static_cast<unsigned long long>(s.dropped),
+        static_cast<unsigned long long>(s.malformed), s.clock_state.c_str(),
+        static_cast<long long>(s.clock_offset_ns), s.clock_drift_ppm, s.clock_jitter_ns,
+        s.clock_uncertainty_ns, s.health.c_str());
+  }
+}
+
+/// Takes everything waiting on `topic`, prints it, feeds the stats; returns how many.
+template <class Message, class Take, class Print>
+std::size_t drain(Take take, Print print, bool as_csv, EchoStats& stats, std::size_t limit) {
+  std::vector<dds::Received<Message>> samples;
+  take(samples);
+  std::size_t printed = 0;
+  for (const auto& r : samples) {
+    if (limit != 0 && stats.count() >= limit) break;  // exactly --count lines
+    print(r, as_csv);
+    stats.add(r.msg.stamp, r.received_wall, r.received_host);
+    ++printed;
+  }
+  std::fflush(stdout);
+  return printed;
+}
+
+}  // namespace
+
+int run_echo(int argc, char** argv) {
+  CLI::App app{
+      "Print samples of one of posed's DDS topics (ROS 2 types) with units, or as CSV.\n"
+      "Reports receive rate [Hz] and stamp-to-receive latency [ms] every second and at exit.",
+      "posectl echo"};
+  std::string topic_arg = "rt/posed/odom";
+  bool as_csv = false;
+  std::size_t count = 0;
+  double timeout_s = 0.0;
+  std::uint32_t domain = 0;
+  std::string cyclone_config;
+  app.add_option("topic", topic_arg,
+                 "odom, pose, status, or the full DDS name (rt/posed/odom) or ROS name")
+      ->capture_default_str();
+  app.add_flag("--csv", as_csv,
+               "CSV with a header line on stdout; rate/latency reports go to stderr");
+  app.add_option("--count,-n", count, "exit 0 after N samples (0: until Ctrl-C or --timeout)");
+  app.add_option("--timeout,-t", timeout_s,
+                 "give up after S seconds [s]; fails unless --count was reached (or, without "
+                 "--count, unless anything arrived). 0: no limit")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--domain,-d", domain, "DDS domain id (ROS_DOMAIN_ID)")->capture_default_str();
+  app.add_option("--cyclonedds-config", cyclone_config,
+                 "Cyclone XML file (e.g. config/cyclonedds-loopback.xml); default: CYCLONEDDS_URI "
+                 "or Cyclone's built-in defaults");
+  CLI11_PARSE(app, argc, argv);
+
+  dds::Topic topic = dds::Topic::kOdom;
+  if (!dds::parse_topic(topic_arg, topic)) {
+    std::fprintf(stderr,
+                 "posectl echo: unknown topic '%s' (expected odom, pose, status or "
+                 "rt/posed/{odom,pose,status})\n",
+                 topic_arg.c_str());
+    return 2;
+  }
+  const std::string topic_name(dds::topic_name(topic));
+
+  dds::DdsConfig config;
+  config.domain_id = domain;
+  config.cyclonedds_xml_path = cyclone_config;
+  std::string error;
+  const std::array topics = {topic};
+  auto subscriber = dds::Subscriber::create(config, topics, error);
+  if (!subscriber) {
+    std::fprintf(stderr, "posectl echo: %s\n", error.c_str());
+    return 1;
+  }
+
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  std::FILE* report_out = as_csv ? stderr : stdout;
+  if (as_csv) {
+    if (topic == dds::Topic::kOdom) print_odom_header_csv();
+    if (topic == dds::Topic::kPose) print_pose_header_csv();
+    if (topic == dds::Topic::kStatus) print_status_header_csv();
+  }
+  std::fprintf(stderr, "posectl echo: listening on %s (domain %u)\n", topic_name.c_str(), domain);
+
+  EchoStats stats;
+  const HostTime start = drivers::host_now();
+  stats.window_begin = start;
+  const Duration report_every = Duration::from_s(1);
+  const Duration limit = Duration::from_seconds(timeout_s);
+  bool timed_out = false;
+  while (!g_interrupted.load() && (count == 0 || stats.count() < count)) {
+    const HostTime now = drivers::host_now();
+    if (timeout_s > 0 && now - start >= limit) {
+      timed_out = true;
+      break;
+    }
+    if (now - stats.window_begin >= report_every) {
+      stats.report_window(report_out, topic_name.c_str(), now,
+                          subscriber->matched_publishers(topic));
+    }
+    // Short waits keep Ctrl-C, the timeout and the periodic report responsive.
+    if (!subscriber->wait(Duration::from_ms(100))) continue;
+    switch (topic) {
+      case dds::Topic::kOdom:
+        drain<dds::OdomMessage>([&](auto& v) { subscriber->take_odom(v); }, print_odom, as_csv,
+                                stats, count);
+        break;
+      case dds::Topic::kPose:
+        drain<dds::PoseMessage>([&](auto& v) { subscriber->take_pose(v); }, print_pose, as_csv,
+                                stats, count);
+        break;
+      case dds::Topic::kStatus:
+        drain<dds::StatusMessage>([&](auto& v) { subscriber->take_status(v); }, print_status,
+                                  as_csv, stats, count);
+        break;
+    }
+  }
+  stats.report_summary(report_out, topic_name.c_str());
+
+  const bool short_of_count = count != 0 && stats.count() < count;
+  if (short_of_count || (timed_out && stats.count() == 0)) {
+    std::fprintf(stderr,
+                 "posectl echo: %s: %zu of %s samples on %s (domain %u) after %.1f s; matched "
+                 "publishers: %u (is posed running with the same domain and Cyclone config?)\n",
+                 timed_out ? "timeout" : "interrupted", stats.count(),
+                 count != 0 ? std::to_string(count).c_str() : "at least 1", topic_name.c_str(),
+                 domain, (drivers::host_now() - start).seconds(),
+                 subscriber->matched_publishers(topic));
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace posed::posectl
