@@ -51,6 +51,11 @@ const Field kSchema[] = {
       10, "", "accelerometer bias random walk"),
     F("imu.gravity_mps2", imu.gravity_mps2, "9.805", "m/s^2", 9.7, 9.9, "",
       "local gravity magnitude"),
+    F("imu.clock_kind", imu.clock_kind, "counter_us_32bit", "", 0, 0,
+      "counter_us_32bit|us_past_hour|hardware_ns|none",
+      "how the IMU stamps samples (the A9: a 32-bit microsecond counter)"),
+    F("imu.clock_latency_s", imu.clock_latency_s, "0", "s", 0, 1, "",
+      "minimum transport latency from the device stamp to host arrival (not observable)"),
 
     F("synthetic_imu.rate_hz", synthetic_imu.rate_hz, "200", "Hz", 1, 2000, "",
       "sample rate of the synthetic IMU"),
@@ -83,6 +88,11 @@ const Field kSchema[] = {
     F("lidar.max_range_m", lidar.max_range_m, "120", "m", 1, 300, "",
       "returns farther are dropped"),
     F("lidar.rpm", lidar.rpm, "600", "rpm", 300, 1200, "", "configured rotation speed"),
+    F("lidar.clock_kind", lidar.clock_kind, "us_past_hour", "", 0, 0,
+      "counter_us_32bit|us_past_hour|hardware_ns|none",
+      "how the lidar stamps packets (VLP-32C: microseconds past the hour)"),
+    F("lidar.clock_latency_s", lidar.clock_latency_s, "0", "s", 0, 1, "",
+      "minimum transport latency from the device stamp to host arrival"),
 
     F("visible_camera.enabled", visible_camera.enabled, "false", "", 0, 0, "",
       "read the D435i colour stream"),
@@ -103,6 +113,9 @@ const Field kSchema[] = {
     F("visible_camera.p2", visible_camera.p2, "0", "", -1, 1, "", "tangential p2"),
     F("visible_camera.latency_s", visible_camera.latency_s, "0", "s", 0, 1, "",
       "arrival minus exposure midpoint when the stream has no clock"),
+    F("visible_camera.clock_kind", visible_camera.clock_kind, "hardware_ns", "", 0, 0,
+      "counter_us_32bit|us_past_hour|hardware_ns|none",
+      "how the camera stamps frames (D435i: hardware clock in the UVC metadata)"),
 
     F("thermal_camera.enabled", thermal_camera.enabled, "false", "", 0, 0, "", "read the PLUG 617"),
     F("thermal_camera.device", thermal_camera.device, "\"\"", "", 0, 0, "",
@@ -122,6 +135,12 @@ const Field kSchema[] = {
     F("thermal_camera.p2", thermal_camera.p2, "0", "", -1, 1, "", "tangential p2"),
     F("thermal_camera.latency_s", thermal_camera.latency_s, "0.03", "s", 0, 1, "",
       "arrival minus exposure midpoint (the PLUG 617 over UVC has no clock)"),
+    F("thermal_camera.clock_kind", thermal_camera.clock_kind, "none", "", 0, 0,
+      "counter_us_32bit|us_past_hour|hardware_ns|none",
+      "how the camera stamps frames (PLUG 617 over UVC: none, host arrival only)"),
+
+    F("sync.pairing_tolerance_s", sync.pairing_tolerance_s, "0.01", "s", 0.0001, 0.5, "",
+      "visible and thermal frames further apart than this are not paired"),
 
     F("extrinsics.T_imu_lidar", extrinsics.T_imu_lidar,
       "[1, 0, 0, 0.27255, 0, 1, 0, -0.00053, 0, 0, 1, 0.17954, 0, 0, 0, 1]", "m", 0, 0, "",

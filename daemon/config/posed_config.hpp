@@ -40,6 +40,8 @@ struct ImuSection {
   double accel_noise_density = 0.0;  ///< [m/s^2/sqrt(Hz)]
   double accel_random_walk = 0.0;    ///< [m/s^3/sqrt(Hz)]
   double gravity_mps2 = 9.805;       ///< local gravity magnitude [m/s^2]
+  std::string clock_kind;            ///< counter_us_32bit | us_past_hour | hardware_ns | none
+  double clock_latency_s = 0;        ///< minimum transport latency, device stamp to arrival [s]
 };
 
 struct SyntheticImuSection {
@@ -63,6 +65,8 @@ struct LidarSection {
   double min_range_m = 0.5;
   double max_range_m = 120.0;
   double rpm = 600.0;
+  std::string clock_kind;        ///< how the device stamps packets
+  double clock_latency_s = 0;    ///< minimum transport latency [s]
 };
 
 struct CameraSection {
@@ -74,6 +78,11 @@ struct CameraSection {
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics [px]
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  ///< radial-tangential distortion
   double latency_s = 0;  ///< host arrival minus exposure midpoint, for clockless streams [s]
+  std::string clock_kind;  ///< hardware_ns (D435i metadata) | none (UVC thermal)
+};
+
+struct SyncSection {
+  double pairing_tolerance_s = 0.01;  ///< visible/thermal frames further apart are not paired [s]
 };
 
 struct ExtrinsicsSection {
@@ -116,6 +125,7 @@ struct PosedConfig {
   LidarSection lidar;
   CameraSection visible_camera;
   CameraSection thermal_camera;
+  SyncSection sync;
   ExtrinsicsSection extrinsics;
   EstimatorSection estimator;
   ThreadsSection threads;

@@ -19,6 +19,14 @@ namespace {
 constexpr auto kWaitTimeout = std::chrono::milliseconds(50);
 const Duration kReadTimeout = Duration::from_ms(100);
 
+// The schema admits only these names (config_schema.cpp), so the last branch is "none".
+DeviceClockKind clock_kind_from(const std::string& name) {
+  if (name == "counter_us_32bit") return DeviceClockKind::kCounterUs32Bit;
+  if (name == "us_past_hour") return DeviceClockKind::kUsPastHour;
+  if (name == "hardware_ns") return DeviceClockKind::kHardwareNs;
+  return DeviceClockKind::kNone;
+}
+
 DropPolicy queue_policy(const PipelineSources& sources) {
   return sources.imu && !sources.imu->live() ? DropPolicy::kBlockWithTimeout
                                              : DropPolicy::kDropOldest;
@@ -54,10 +62,11 @@ struct Pipeline::Impl {
   ClockSyncStatus imu_clock_status;  // guarded by snapshot_mutex
 
   Impl(const config::PosedConfig& c)
-      : imu_clock(ClockSyncConfig{.kind = DeviceClockKind::kCounterUs32Bit,
+      : imu_clock(ClockSyncConfig{.kind = clock_kind_from(c.imu.clock_kind),
                                   .nominal_rate_hz = c.imu.source == "synthetic"
                                                          ? c.synthetic_imu.rate_hz
-                                                         : c.imu.rate_hz}),
+                                                         : c.imu.rate_hz,
+                                  .latency = Duration::from_seconds(c.imu.clock_latency_s)}),
         mounting(mounting_from(c.imu.R_imu_sensor)),
         strapdown(StrapdownConfig{
             .gravity_mps2 = c.imu.gravity_mps2,
