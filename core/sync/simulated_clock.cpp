@@ -95,4 +95,20 @@ std::vector<SimulatedSample> simulate_stream(const SimulatedStreamConfig& c, Dur
   return out;
 }
 
+SimulatedStreamConfig harsh_transport(DeviceClockKind kind, double rate_hz, double drift_ppm,
+                                      Duration latency, std::uint64_t seed) {
+  SimulatedStreamConfig c;
+  c.kind = kind;
+  c.rate_hz = rate_hz;
+  c.drift_ppm = drift_ppm;
+  c.latency = latency;
+  c.jitter_mean = Duration::from_ms(1);
+  c.jitter_max = Duration::from_ms(5);
+  c.spike_probability = 0.005;
+  c.spike_delay = Duration::from_ms(50);
+  c.drop_probability = 0.10;
+  c.seed = seed;
+  return c;
+}
+
 }  // namespace posed

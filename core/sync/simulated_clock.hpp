@@ -62,4 +62,10 @@ struct SimulatedSample {
 /// Simulates `length` of host time; samples in arrival order (dropped ones absent).
 std::vector<SimulatedSample> simulate_stream(const SimulatedStreamConfig& config, Duration length);
 
+/// The transport the time-sync issue specifies for clocked devices, shared by the tests and
+/// `posectl bench sync`: 0-5 ms one-sided exponential jitter (mean 1 ms), 0.5 % spikes of 50 ms,
+/// 10 % of samples lost, on top of a fixed `latency`.
+SimulatedStreamConfig harsh_transport(DeviceClockKind kind, double rate_hz, double drift_ppm,
+                                      Duration latency, std::uint64_t seed);
+
 }  // namespace posed

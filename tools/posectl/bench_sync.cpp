@@ -30,22 +30,10 @@ struct Stream {
   SimulatedStreamConfig sim;
 };
 
-/// Clocked devices: 0-5 ms one-sided exponential jitter (mean 1 ms), 0.5 % spikes of 50 ms,
-/// 10 % of samples lost.
+/// Clocked devices: the transport model (core/sync/simulated_clock.hpp), 700 µs latency.
 SimulatedStreamConfig clocked(DeviceClockKind kind, double rate_hz, double drift_ppm,
                               std::uint64_t seed) {
-  SimulatedStreamConfig c;
-  c.kind = kind;
-  c.rate_hz = rate_hz;
-  c.drift_ppm = drift_ppm;
-  c.latency = Duration::from_us(700);
-  c.jitter_mean = Duration::from_ms(1);
-  c.jitter_max = Duration::from_ms(5);
-  c.spike_probability = 0.005;
-  c.spike_delay = Duration::from_ms(50);
-  c.drop_probability = 0.10;
-  c.seed = seed;
-  return c;
+  return harsh_transport(kind, rate_hz, drift_ppm, Duration::from_us(700), seed);
 }
 
 std::vector<Stream> clocked_streams() {

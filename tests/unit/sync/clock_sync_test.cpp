@@ -12,22 +12,10 @@
 namespace posed {
 namespace {
 
-/// The transport model: 0-5 ms one-sided exponential jitter, rare 50 ms spikes, 10 %
-/// of samples lost.
+/// The transport model (core/sync/simulated_clock.hpp) with 800 µs of fixed latency.
 SimulatedStreamConfig harsh_stream(DeviceClockKind kind, double rate_hz, double drift_ppm,
                                    std::uint64_t seed) {
-  SimulatedStreamConfig c;
-  c.kind = kind;
-  c.rate_hz = rate_hz;
-  c.drift_ppm = drift_ppm;
-  c.latency = Duration::from_us(800);
-  c.jitter_mean = Duration::from_ms(1);
-  c.jitter_max = Duration::from_ms(5);
-  c.spike_probability = 0.005;
-  c.spike_delay = Duration::from_ms(50);
-  c.drop_probability = 0.10;
-  c.seed = seed;
-  return c;
+  return harsh_transport(kind, rate_hz, drift_ppm, Duration::from_us(800), seed);
 }
 
 ClockSyncConfig config_for(const SimulatedStreamConfig& sim) {
