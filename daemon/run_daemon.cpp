@@ -164,11 +164,13 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
 
   notify::SdNotifier notifier;
   notify::StageWatchdog watchdog;
-  std::array<std::size_t, pipeline::kStageNames.size()> stage_ids{};
-  for (std::size_t i = 0; i < stage_ids.size(); ++i) {
-    stage_ids[i] =
-        watchdog.register_stage(std::string(pipeline::kStageNames[i]),
-                                Duration::from_seconds(config.watchdog.stage_deadline_s), started);
+  // Only the stages this pipeline runs are watched; a stage that never started cannot stall.
+  std::vector<std::pair<pipeline::Stage, notify::StageWatchdog::StageId>> watched;
+  for (const pipeline::Stage stage : pipe.active_stages()) {
+    watched.emplace_back(
+        stage,
+        watchdog.register_stage(std::string(pipeline::kStageNames[static_cast<std::size_t>(stage)]),
+                                Duration::from_seconds(config.watchdog.stage_deadline_s), started));
   }
   notify::WatchdogPinger pinger(notifier.watchdog_interval());
   notifier.notify("READY=1\nSTATUS=sources open, aligning");
@@ -202,7 +204,9 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
       pipe.request_stop();
     }
     const auto beats = pipe.stage_heartbeats();
-    for (std::size_t i = 0; i < beats.size(); ++i) watchdog.heartbeat(stage_ids[i], beats[i]);
+    for (const auto& [stage, id] : watched) {
+      watchdog.heartbeat(id, beats[static_cast<std::size_t>(stage)]);
+    }
     std::string line;
     {
       std::lock_guard lock(status_line_mutex);
@@ -232,6 +236,15 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
         run_s > 0 ? static_cast<double>(s.decoded) / run_s : 0.0,
         static_cast<unsigned long long>(s.malformed), static_cast<unsigned long long>(s.dropped),
         s.clock_state.c_str(), static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
+  }
+  if (config.lidar.enabled) {
+    std::printf(
+        "  lidar scans         %llu assembled (%.0f points/scan mean), %llu reached the "
+        "fusion core (not used by the strapdown estimator)\n",
+        static_cast<unsigned long long>(st.lidar_scans),
+        st.lidar_scans ? static_cast<double>(st.lidar_points) / static_cast<double>(st.lidar_scans)
+                       : 0.0,
+        static_cast<unsigned long long>(st.lidar_scans_fused));
   }
   std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
               static_cast<unsigned long long>(tally.odom),

@@ -77,6 +77,13 @@ const Field kSchema[] = {
       "fault injection: the fake device hangs in read() after this long (0 = never)"),
 
     F("lidar.enabled", lidar.enabled, "false", "", 0, 0, "", "read the VLP-32C"),
+    F("lidar.source", lidar.source, "udp", "", 0, 0, "udp|pcap",
+      "udp: the sensor; pcap: a capture (Wireshark, VeloView) played as if live"),
+    P("lidar.pcap_file", lidar.pcap_file, "pcap or pcapng capture for lidar.source pcap"),
+    F("lidar.pcap_speed", lidar.pcap_speed, "1", "x", 0.01, 1000, "",
+      "playback speed of the capture (1 = original timing)"),
+    F("lidar.cut_azimuth_deg", lidar.cut_azimuth_deg, "0", "deg", 0, 359.99, "",
+      "azimuth where one scan ends and the next begins"),
     F("lidar.address", lidar.address, "192.168.1.201", "", 0, 0, "",
       "sensor IPv4 address; datagrams from other senders are dropped"),
     F("lidar.data_port", lidar.data_port, "2368", "", 1, 65535, "", "UDP port of data packets"),
@@ -162,6 +169,10 @@ const Field kSchema[] = {
       "SCHED_FIFO priority of the IMU source thread (0 = normal scheduling)"),
     F("threads.imu_source.cpu", threads.imu_source.cpu, "-1", "", -1, 1023, "",
       "CPU the IMU source thread is pinned to (-1 = any)"),
+    F("threads.lidar_source.priority", threads.lidar_source.priority, "0", "", 0, 50, "",
+      "SCHED_FIFO priority of the lidar source thread (0 = normal scheduling)"),
+    F("threads.lidar_source.cpu", threads.lidar_source.cpu, "-1", "", -1, 1023, "",
+      "CPU the lidar source thread is pinned to (-1 = any)"),
     F("threads.fusion.priority", threads.fusion.priority, "0", "", 0, 50, "",
       "SCHED_FIFO priority of the fusion thread (0 = normal scheduling)"),
     F("threads.fusion.cpu", threads.fusion.cpu, "-1", "", -1, 1023, "",
@@ -173,6 +184,8 @@ const Field kSchema[] = {
 
     F("queues.imu_capacity", queues.imu_capacity, "1024", "samples", 8, 1048576, "",
       "IMU queue between the IMU source and the fusion core (drop-oldest)"),
+    F("queues.scan_capacity", queues.scan_capacity, "4", "scans", 2, 64, "",
+      "lidar scans between the lidar source and the fusion core (drop-oldest when live)"),
     F("queues.state_capacity", queues.state_capacity, "1024", "states", 8, 1048576, "",
       "state queue between the fusion core and the publisher (drop-oldest)"),
 

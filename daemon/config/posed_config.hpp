@@ -58,15 +58,19 @@ struct SyntheticImuSection {
 
 struct LidarSection {
   bool enabled = false;
-  std::string address;  ///< sensor IPv4 address; datagrams from elsewhere are dropped
+  std::string source;          ///< udp (the sensor) | pcap (a capture played as if live)
+  std::string pcap_file;       ///< capture for source pcap
+  double pcap_speed = 1.0;     ///< 1 = original timing, N = N times faster
+  double cut_azimuth_deg = 0;  ///< where one scan ends and the next begins [deg]
+  std::string address;         ///< sensor IPv4 address; datagrams from elsewhere are dropped
   int data_port = 2368;
   int position_port = 8308;
   std::string calibration;  ///< VeloView XML / ros-drivers YAML / velodyne_decoder YAML
   double min_range_m = 0.5;
   double max_range_m = 120.0;
   double rpm = 600.0;
-  std::string clock_kind;        ///< how the device stamps packets
-  double clock_latency_s = 0;    ///< minimum transport latency [s]
+  std::string clock_kind;      ///< how the device stamps packets
+  double clock_latency_s = 0;  ///< minimum transport latency [s]
 };
 
 struct CameraSection {
@@ -77,7 +81,7 @@ struct CameraSection {
   double rate_hz = 0;                     ///< [Hz]
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics [px]
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  ///< radial-tangential distortion
-  double latency_s = 0;  ///< host arrival minus exposure midpoint, for clockless streams [s]
+  double latency_s = 0;    ///< host arrival minus exposure midpoint, for clockless streams [s]
   std::string clock_kind;  ///< hardware_ns (D435i metadata) | none (UVC thermal)
 };
 
@@ -104,12 +108,14 @@ struct ThreadSection {
 
 struct ThreadsSection {
   ThreadSection imu_source;
+  ThreadSection lidar_source;
   ThreadSection fusion;
   ThreadSection publisher;
 };
 
 struct QueuesSection {
   int imu_capacity = 1024;    ///< IMU samples between the IMU source and the fusion core
+  int scan_capacity = 4;      ///< lidar scans between the lidar source and the fusion core
   int state_capacity = 1024;  ///< propagated states between the fusion core and the publisher
 };
 

@@ -28,6 +28,8 @@ namespace posed::pipeline {
 struct PipelineSources {
   /// bytes in the A9 wire format (live serial, synthetic, or replayed)
   std::unique_ptr<drivers::Source> imu;
+  /// VLP-32C UDP payloads, channel 0 data, 1 position (live UDP, pcap, or replayed); optional
+  std::unique_ptr<drivers::Source> lidar;
 };
 
 /// Per-stream figures for rt/posed/status and the exit summary.
@@ -50,8 +52,11 @@ struct PipelineStatus {
   HostTime stamp;
   EstimatorMode mode = EstimatorMode::kAligning;
   std::vector<StreamStatus> streams;
-  std::uint64_t states = 0;          ///< states produced by the fusion core
-  std::uint64_t states_dropped = 0;  ///< states dropped between fusion and publisher
+  std::uint64_t lidar_scans = 0;        ///< scans assembled
+  std::uint64_t lidar_points = 0;       ///< points in those scans
+  std::uint64_t lidar_scans_fused = 0;  ///< scans the fusion core received
+  std::uint64_t states = 0;             ///< states produced by the fusion core
+  std::uint64_t states_dropped = 0;     ///< states dropped between fusion and publisher
 };
 
 /// Callbacks run on the publisher thread.
@@ -62,9 +67,9 @@ struct PipelineOutputs {
   std::function<void(const PipelineStatus&)> on_status;
 };
 
-enum class Stage : std::uint8_t { kImuSource, kFusion, kPublisher };
-inline constexpr std::array<std::string_view, 3> kStageNames = {"imu_source", "fusion",
-                                                                "publisher"};
+enum class Stage : std::uint8_t { kImuSource, kLidarSource, kFusion, kPublisher };
+inline constexpr std::array<std::string_view, 4> kStageNames = {"imu_source", "lidar_source",
+                                                                "fusion", "publisher"};
 
 class Pipeline {
  public:
@@ -79,7 +84,9 @@ class Pipeline {
   /// Drain: Sources stop, queued data flows through, threads end. Safe from any thread.
   void request_stop();
   /// True once every stage thread has finished.
-  bool finished() const { return finished_stages_.load() == kStageNames.size(); }
+  bool finished() const { return finished_stages_.load() == active_stages().size(); }
+  /// The stages this pipeline runs (the lidar stage only with a lidar Source).
+  std::vector<Stage> active_stages() const;
   /// Joins the threads (call after finished() or request_stop()).
   void join();
 
@@ -93,6 +100,10 @@ class Pipeline {
     ImuSample sample;
     bool end_of_stream = false;
   };
+  struct ScanItem {
+    LidarScan scan;
+    bool end_of_stream = false;
+  };
   struct StateItem {
     NavState state;
     bool end_of_stream = false;
@@ -100,6 +111,7 @@ class Pipeline {
   struct Impl;
 
   void run_imu_source();
+  void run_lidar_source();
   void run_fusion();
   void run_publisher();
   void beat(Stage stage);
@@ -108,8 +120,10 @@ class Pipeline {
   PipelineSources sources_;
   PipelineOutputs outputs_;
   SpscQueue<ImuItem> imu_queue_;
+  SpscQueue<ScanItem> scan_queue_;
   SpscQueue<StateItem> state_queue_;
-  Wakeup imu_ready_;
+  /// signalled by both source stages: the fusion core has input
+  Wakeup fusion_ready_;
   Wakeup state_ready_;
   std::unique_ptr<Impl> impl_;
   std::array<std::atomic<std::int64_t>, kStageNames.size()> heartbeat_ns_{};

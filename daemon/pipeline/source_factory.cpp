@@ -1,6 +1,8 @@
 #include "daemon/pipeline/source_factory.hpp"
 
 #include "drivers/imu/serial_source.hpp"
+#include "drivers/recording/pcap_source.hpp"
+#include "drivers/velodyne/udp_source.hpp"
 
 namespace posed::pipeline {
 
@@ -33,6 +35,26 @@ BuiltSources make_sources(const config::PosedConfig& config, std::string& error)
   } else {
     // The schema only admits the values above; this guards against a new one not wired here.
     error = "imu.source '" + config.imu.source + "' has no Source in make_sources()";
+  }
+  if (!error.empty() || !config.lidar.enabled) return built;
+  if (config.lidar.source == "udp") {
+    drivers::velodyne::UdpSourceConfig udp;
+    udp.sensor_address = config.lidar.address;
+    udp.data_port = static_cast<std::uint16_t>(config.lidar.data_port);
+    udp.position_port = static_cast<std::uint16_t>(config.lidar.position_port);
+    built.sources.lidar = std::make_unique<drivers::velodyne::UdpSource>(std::move(udp));
+  } else if (config.lidar.source == "pcap") {
+    if (config.lidar.pcap_file.empty()) {
+      error = "lidar.source is pcap but lidar.pcap_file is empty";
+      built.sources = {};
+      return built;
+    }
+    drivers::recording::PcapSourceConfig pcap;
+    pcap.path = config.lidar.pcap_file;
+    pcap.ports = {static_cast<std::uint16_t>(config.lidar.data_port),
+                  static_cast<std::uint16_t>(config.lidar.position_port)};
+    pcap.speed = config.lidar.pcap_speed;
+    built.sources.lidar = std::make_unique<drivers::recording::PcapSource>(std::move(pcap));
   }
   return built;
 }

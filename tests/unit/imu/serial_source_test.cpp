@@ -150,7 +150,8 @@ TEST(SerialSource, StreamsAt150HzWithSplitsGarbageAndBadCrc) {
   EXPECT_EQ(c.skipped_bytes, garbage_bytes + corrupted * a9::kSensorFrameSize);
   const SourceCounters sc = source.counters();
   EXPECT_EQ(sc.bytes, kFrames * a9::kSensorFrameSize + garbage_bytes);
-  EXPECT_GT(sc.chunks, kFrames);  // the split writes really arrived as separate reads
+  // How many reads the split writes arrive in depends on scheduling (a loaded machine coalesces
+  // them); frames split at every byte are covered deterministically in a9_protocol_test.
   EXPECT_EQ(sc.reopened, 0u);
 }
 
