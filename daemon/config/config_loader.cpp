@@ -62,9 +62,11 @@ class Loader {
 
   // Walks a mapping; every leaf must be a schema key.
   void walk(const YAML::Node& node, const std::string& prefix) {
+    // Copies, not references: yaml-cpp's iterator hands out a temporary pair, so a reference to
+    // it->first dangles at the end of the statement (ASan: stack-use-after-scope).
     for (auto it = node.begin(); it != node.end(); ++it) {
-      const YAML::Node& key_node = it->first;
-      const YAML::Node& value = it->second;
+      const YAML::Node key_node = it->first;
+      const YAML::Node value = it->second;
       if (!key_node.IsScalar()) {
         error(key_node, prefix, "keys must be plain names");
         continue;
