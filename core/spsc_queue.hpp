@@ -6,8 +6,10 @@
 // drop-oldest needs the *producer* to discard the oldest item when full. With a plain ring that
 // races with the consumer reading the same slot. Here a slot is claimed with a CAS on the read
 // index before it is read, so the producer can claim-and-discard exactly like the consumer, and
-// neither ever touches a slot the other owns.
+// neither ever touches a slot the other owns. Under the other policies only the consumer claims,
+// and the same cells run as a plain ring (see try_emplace()), which moves half the cache lines.
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <chrono>
@@ -109,13 +111,18 @@ class SpscQueue {
       }
       case DropPolicy::kBlockWithTimeout: {
         const auto deadline = WaitClock::now() + block_timeout_;
+        // A full queue means the consumer is busy for a while (a replay waiting on a scan's
+        // registration): back off exponentially, 50 µs up to 2 ms, so a blocked producer costs a
+        // few hundred wake-ups a second, not tens of thousands.
         int spins = 0;
+        auto pause = std::chrono::microseconds(50);
         while (WaitClock::now() < deadline) {
           if (try_emplace(item)) return PushResult::kPushed;
           if (++spins < 64) {
             std::this_thread::yield();
           } else {
-            std::this_thread::sleep_for(std::chrono::microseconds(50));
+            std::this_thread::sleep_for(pause);
+            pause = std::min(pause * 2, std::chrono::microseconds(2000));
           }
         }
         bump(rejected_timeout_);
@@ -164,9 +171,13 @@ class SpscQueue {
   }
 
  private:
-  struct Cell {
+  // A cell per cache line (at least): the producer filling cell i+1 never invalidates the line
+  // the consumer is reading cell i from. The item lives in raw storage, not an optional, so a
+  // consumer taking a trivially destructible item only reads the cell.
+  struct alignas(kCacheLine) Cell {
     std::atomic<std::size_t> seq{0};
-    std::optional<T> value;
+    alignas(T) std::byte storage[sizeof(T)];
+    T* item() { return std::launder(reinterpret_cast<T*>(storage)); }
   };
 
   // Counters have a single writer each, so a relaxed load+store is enough (no RMW on hot paths).
@@ -174,23 +185,52 @@ class SpscQueue {
     c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   }
 
+  // Two protocols share the cells. A cell holds an item for position `pos` once its seq is pos+1
+  // (the producer's release store). Whether it is free again differs:
+  //  - drop-oldest (the producer may claim too): Vyukov's — the claimer CASes read_pos_, then
+  //    marks the cell free for the next lap with seq = pos + capacity;
+  //  - otherwise (only the consumer claims): the classic ring — the consumer only publishes
+  //    read_pos_, and the producer finds space from its cached copy of it. The consumer never
+  //    writes a cell, so each item crosses between the cores once instead of twice.
   bool try_emplace(T& item) {
     const std::size_t pos = write_pos_.load(std::memory_order_relaxed);
     Cell& cell = cells_[pos & mask_];
-    if (cell.seq.load(std::memory_order_acquire) != pos) return false;  // full or being read
-    cell.value.emplace(std::move(item));
+    if (claimable_) {
+      if (cell.seq.load(std::memory_order_acquire) != pos) return false;  // full or being read
+    } else if (pos - cached_read_pos_ >= capacity_) {
+      cached_read_pos_ = read_pos_.load(std::memory_order_acquire);
+      if (pos - cached_read_pos_ >= capacity_) return false;  // full
+    }
+    ::new (static_cast<void*>(cell.storage)) T(std::move(item));
     cell.seq.store(pos + 1, std::memory_order_release);
     write_pos_.store(pos + 1, std::memory_order_release);
     bump(pushed_);
-    const std::size_t depth = pos + 1 - read_pos_.load(std::memory_order_relaxed);
-    if (depth > high_water_.load(std::memory_order_relaxed) && depth <= capacity_) {
-      high_water_.store(depth, std::memory_order_relaxed);
+    // High water from a cached read position: reading the consumer's index on every push would
+    // move its cache line between the cores each time. The cached value is never ahead of the
+    // real one, so the estimate is an upper bound: only when it beats the mark is the real index
+    // read, and the mark stays exact.
+    const std::size_t high_water = high_water_.load(std::memory_order_relaxed);
+    if (pos + 1 - cached_read_pos_ > high_water) {
+      cached_read_pos_ = read_pos_.load(std::memory_order_acquire);
+      const std::size_t depth = pos + 1 - cached_read_pos_;
+      if (depth > high_water && depth <= capacity_) {
+        high_water_.store(depth, std::memory_order_relaxed);
+      }
     }
     return true;
   }
 
-  // Claims the oldest cell (consumer, or producer discarding under drop-oldest).
+  // Takes the oldest item (the consumer, or the producer discarding under drop-oldest).
   bool claim(T& out) {
+    if (!claimable_) {
+      const std::size_t pos = read_pos_.load(std::memory_order_relaxed);
+      Cell& cell = cells_[pos & mask_];
+      if (cell.seq.load(std::memory_order_acquire) != pos + 1) return false;  // empty
+      out = std::move(*cell.item());
+      cell.item()->~T();
+      read_pos_.store(pos + 1, std::memory_order_release);
+      return true;
+    }
     std::size_t pos = read_pos_.load(std::memory_order_relaxed);
     for (;;) {
       Cell& cell = cells_[pos & mask_];
@@ -199,8 +239,8 @@ class SpscQueue {
       if (diff == 0) {
         if (read_pos_.compare_exchange_weak(pos, pos + 1, std::memory_order_acq_rel,
                                             std::memory_order_relaxed)) {
-          out = std::move(*cell.value);
-          cell.value.reset();
+          out = std::move(*cell.item());
+          cell.item()->~T();
           cell.seq.store(pos + capacity_, std::memory_order_release);
           return true;
         }
@@ -216,10 +256,13 @@ class SpscQueue {
   const std::size_t capacity_;
   const std::size_t mask_;
   const DropPolicy policy_;
+  /// the producer may claim (drop-oldest): Vyukov's protocol, see try_emplace()
+  const bool claimable_ = policy_ == DropPolicy::kDropOldest;
   const std::chrono::nanoseconds block_timeout_;
   std::unique_ptr<Cell[]> cells_;
 
   alignas(kCacheLine) std::atomic<std::size_t> write_pos_{0};
+  std::size_t cached_read_pos_ = 0;  // producer only: read_pos_ as last seen, for high water
   alignas(kCacheLine) std::atomic<std::size_t> read_pos_{0};
   // Producer-written counters share a line; the consumer-written one has its own.
   alignas(kCacheLine) std::atomic<std::uint64_t> pushed_{0};
