@@ -11,8 +11,11 @@
 namespace posed {
 
 enum class EstimatorMode : std::uint8_t {
-  kAligning,   ///< collecting the static window for the gravity alignment; no pose yet
-  kStrapdown,  ///< IMU-only dead reckoning: drifts without bound, no aiding
+  kAligning,       ///< collecting the static window for the gravity alignment; no pose yet
+  kStrapdown,      ///< IMU-only dead reckoning: drifts without bound, no aiding
+  kLidarInertial,  ///< lidar-inertial odometry, every direction constrained by the scans
+  kDegenerate,     ///< lidar-inertial, some direction unconstrained by the last scan (IMU holds it)
+  kReinitialising,  ///< diverged: restarting the window from the last lidar pose
 };
 
 constexpr std::string_view to_string(EstimatorMode m) {
@@ -21,6 +24,12 @@ constexpr std::string_view to_string(EstimatorMode m) {
       return "aligning";
     case EstimatorMode::kStrapdown:
       return "strapdown";
+    case EstimatorMode::kLidarInertial:
+      return "lidar_inertial";
+    case EstimatorMode::kDegenerate:
+      return "degenerate";
+    case EstimatorMode::kReinitialising:
+      return "reinitialising";
   }
   return "unknown";
 }
@@ -39,6 +48,8 @@ struct NavState {
   /// twist covariance, ROS order (vx, vy, vz, wx, wy, wz) in base_link [(m/s)^2, (rad/s)^2]
   Eigen::Matrix<double, 6, 6> twist_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   EstimatorMode mode = EstimatorMode::kStrapdown;
+  /// a state the back end optimised (rt/posed/pose); otherwise IMU propagation (rt/posed/odom)
+  bool optimised = false;
   /// increments with every state
   std::uint64_t sequence = 0;
 };

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "core/estimator/nav_state.hpp"
+#include "core/imu/static_alignment.hpp"
 #include "core/measurements.hpp"
 
 namespace posed {
@@ -50,17 +51,13 @@ class Strapdown {
   const Eigen::Vector3d& gyro_bias() const { return gyro_bias_; }
 
  private:
-  void align(const ImuSample& sample);
+  void align(const imu::StaticAlignmentResult& result);
   NavState propagate(const ImuSample& sample);
 
   StrapdownConfig config_;
   StrapdownCounters counters_;
   bool aligned_ = false;
-  // alignment window
-  HostTime window_start_;
-  Eigen::Vector3d sum_f_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero();
-  std::uint64_t window_samples_ = 0;
+  imu::StaticAlignment alignment_;
   // state
   std::optional<ImuSample> previous_;
   Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero();

@@ -1,0 +1,147 @@
+#include "core/estimator/factors.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "core/estimator/pose_manifold.hpp"
+#include "core/math/so3.hpp"
+
+namespace posed::estimator {
+namespace {
+
+using so3::skew;
+using Mat3 = Eigen::Matrix3d;
+
+/// Writes J_tangent (m x 6) as the ambient m x 7 Jacobian of a pose block.
+template <int M>
+void pose_jacobian(const Eigen::Matrix<double, M, 6>& J_tangent, const double* pose, double* out) {
+  Eigen::Matrix<double, 6, 7, Eigen::RowMajor> minus;
+  PoseManifold().MinusJacobian(pose, minus.data());
+  Eigen::Map<Eigen::Matrix<double, M, 7, Eigen::RowMajor>> J(out);
+  J = J_tangent * minus;
+}
+
+}  // namespace
+
+ImuFactor::ImuFactor(const imu::Preintegration& pre, double gravity_mps2,
+                     const imu::ImuNoise& noise)
+    : pre_(pre), g_(0, 0, -gravity_mps2) {
+  Eigen::Matrix<double, 15, 15> cov = Eigen::Matrix<double, 15, 15>::Zero();
+  cov.topLeftCorner<9, 9>() = pre.covariance();
+  const double dt = pre.dt_s();
+  cov.block<3, 3>(9, 9).diagonal().setConstant(noise.gyro_random_walk * noise.gyro_random_walk *
+                                               dt);
+  cov.block<3, 3>(12, 12).diagonal().setConstant(noise.accel_random_walk * noise.accel_random_walk *
+                                                 dt);
+  // A floor keeps the information finite for very short intervals and noise-free tests.
+  cov += 1e-12 * Eigen::Matrix<double, 15, 15>::Identity();
+  sqrt_info_ = Eigen::LLT<Eigen::Matrix<double, 15, 15>>(cov.inverse()).matrixL().transpose();
+}
+
+bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
+                         double** jacobians) const {
+  const Eigen::Map<const Eigen::Vector3d> pi(parameters[0]), pj(parameters[2]);
+  const Eigen::Map<const Eigen::Quaterniond> qi(parameters[0] + 3), qj(parameters[2] + 3);
+  const Eigen::Map<const Eigen::Vector3d> vi(parameters[1]), bgi(parameters[1] + 3),
+      bai(parameters[1] + 6);
+  const Eigen::Map<const Eigen::Vector3d> vj(parameters[3]), bgj(parameters[3] + 3),
+      baj(parameters[3] + 6);
+  const Mat3 Ri = qi.normalized().toRotationMatrix(), Rj = qj.normalized().toRotationMatrix();
+  const Mat3 Ri_T = Ri.transpose();
+  const imu::ImuBias& lin = pre_.linearisation_bias();
+  const Eigen::Vector3d dbg = bgi - lin.gyro_radps;
+  const double dt = pre_.dt_s();
+
+  const Mat3 Rc = pre_.corrected_delta_R(bgi);
+  const Mat3 E = Rc.transpose() * Ri_T * Rj;
+  const Eigen::Vector3d r_R = so3::log(E);
+  const Eigen::Vector3d dv_world = vj - vi - g_ * dt;
+  const Eigen::Vector3d dp_world = pj - pi - vi * dt - 0.5 * g_ * dt * dt;
+  Eigen::Matrix<double, 15, 1> r;
+  r.segment<3>(0) = r_R;
+  r.segment<3>(3) = Ri_T * dv_world - pre_.corrected_delta_v(bgi, bai);
+  r.segment<3>(6) = Ri_T * dp_world - pre_.corrected_delta_p(bgi, bai);
+  r.segment<3>(9) = bgj - bgi;
+  r.segment<3>(12) = baj - bai;
+  Eigen::Map<Eigen::Matrix<double, 15, 1>> out(residuals);
+  out = sqrt_info_ * r;
+  if (jacobians == nullptr) return true;
+
+  const Mat3 Jr_inv = so3::right_jacobian_inverse(r_R);
+  if (jacobians[0] != nullptr) {  // pose i: [dp, dtheta]
+    Eigen::Matrix<double, 15, 6> J = Eigen::Matrix<double, 15, 6>::Zero();
+    J.block<3, 3>(0, 3) = -Jr_inv * Rj.transpose() * Ri;
+    J.block<3, 3>(3, 3) = skew(Ri_T * dv_world);
+    J.block<3, 3>(6, 0) = -Ri_T;
+    J.block<3, 3>(6, 3) = skew(Ri_T * dp_world);
+    pose_jacobian<15>(sqrt_info_ * J, parameters[0], jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {  // speed-bias i: [v, b_g, b_a]
+    Eigen::Matrix<double, 15, 9> J = Eigen::Matrix<double, 15, 9>::Zero();
+    const Mat3 J_bg = pre_.dR_dbg();
+    J.block<3, 3>(0, 3) = -Jr_inv * E.transpose() * so3::right_jacobian(J_bg * dbg) * J_bg;
+    J.block<3, 3>(3, 0) = -Ri_T;
+    J.block<3, 3>(3, 3) = -pre_.dv_dbg();
+    J.block<3, 3>(3, 6) = -pre_.dv_dba();
+    J.block<3, 3>(6, 0) = -Ri_T * dt;
+    J.block<3, 3>(6, 3) = -pre_.dp_dbg();
+    J.block<3, 3>(6, 6) = -pre_.dp_dba();
+    J.block<3, 3>(9, 3) = -Mat3::Identity();
+    J.block<3, 3>(12, 6) = -Mat3::Identity();
+    Eigen::Map<Eigen::Matrix<double, 15, 9, Eigen::RowMajor>> Jm(jacobians[1]);
+    Jm = sqrt_info_ * J;
+  }
+  if (jacobians[2] != nullptr) {  // pose j
+    Eigen::Matrix<double, 15, 6> J = Eigen::Matrix<double, 15, 6>::Zero();
+    J.block<3, 3>(0, 3) = Jr_inv;
+    J.block<3, 3>(6, 0) = Ri_T;
+    pose_jacobian<15>(sqrt_info_ * J, parameters[2], jacobians[2]);
+  }
+  if (jacobians[3] != nullptr) {  // speed-bias j
+    Eigen::Matrix<double, 15, 9> J = Eigen::Matrix<double, 15, 9>::Zero();
+    J.block<3, 3>(3, 0) = Ri_T;
+    J.block<3, 3>(9, 3) = Mat3::Identity();
+    J.block<3, 3>(12, 6) = Mat3::Identity();
+    Eigen::Map<Eigen::Matrix<double, 15, 9, Eigen::RowMajor>> Jm(jacobians[3]);
+    Jm = sqrt_info_ * J;
+  }
+  return true;
+}
+
+LidarPoseFactor::LidarPoseFactor(const Eigen::Isometry3d& T_map_lidar,
+                                 const Eigen::Isometry3d& T_imu_lidar,
+                                 const Eigen::Matrix<double, 6, 6>& information)
+    : p_meas_(T_map_lidar.translation()),
+      R_meas_(T_map_lidar.linear()),
+      p_il_(T_imu_lidar.translation()),
+      R_il_(T_imu_lidar.linear()) {
+  // information = V diag(l) Vᵀ, possibly singular: sqrt = diag(sqrt(l)) Vᵀ.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(
+      0.5 * (information + information.transpose()));
+  sqrt_info_ =
+      es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
+}
+
+bool LidarPoseFactor::Evaluate(double const* const* parameters, double* residuals,
+                               double** jacobians) const {
+  const Eigen::Map<const Eigen::Vector3d> p(parameters[0]);
+  const Mat3 R =
+      Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized().toRotationMatrix();
+  const Mat3 R_meas_T = R_meas_.transpose();
+  const Eigen::Vector3d r_rot = so3::log(Mat3(R_meas_T * R * R_il_));
+  Eigen::Matrix<double, 6, 1> r;
+  r.head<3>() = r_rot;
+  r.tail<3>() = R_meas_T * (p + R * p_il_ - p_meas_);
+  Eigen::Map<Eigen::Matrix<double, 6, 1>> out(residuals);
+  out = sqrt_info_ * r;
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+    J.block<3, 3>(0, 3) = so3::right_jacobian_inverse(r_rot) * R_il_.transpose();
+    J.block<3, 3>(3, 0) = R_meas_T;
+    J.block<3, 3>(3, 3) = -R_meas_T * R * skew(p_il_);
+    pose_jacobian<6>(sqrt_info_ * J, parameters[0], jacobians[0]);
+  }
+  return true;
+}
+
+}  // namespace posed::estimator

@@ -1,0 +1,51 @@
+#pragma once
+// The residuals of the lidar-inertial sliding window, as Ceres cost functions with analytic
+// Jacobians (autodiff of the 15x32 IMU factor cost a minute of compile time per build on two
+// cores, and time per solve). Parameter blocks:
+//   pose        [p (3, map), q (4, Eigen x y z w)]: the IMU (base_link) in map
+//   speed_bias  [v (3, map) [m/s], b_g (3) [rad/s], b_a (3) [m/s²]]
+// Jacobians are derived in the pose manifold's tangent space [dp (map), dtheta (body, right)] and
+// returned in ambient coordinates as J_tangent * MinusJacobian(x) (PoseManifold), whose product
+// with PlusJacobian is J_tangent again. Residuals are whitened by the square-root information.
+
+#include <ceres/sized_cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "core/imu/preintegration.hpp"
+
+namespace posed::estimator {
+
+/// Preintegrated IMU between states i and j (Forster eq. 45) and the bias random walk:
+/// 15 residuals [rotation, velocity, position, gyro bias change, accel bias change].
+class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
+ public:
+  ImuFactor(const imu::Preintegration& pre, double gravity_mps2, const imu::ImuNoise& noise);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  imu::Preintegration pre_;
+  Eigen::Vector3d g_;
+  Eigen::Matrix<double, 15, 15> sqrt_info_;
+};
+
+/// A scan-to-map pose of the lidar, with its information (rotation, translation; right
+/// perturbation), on the IMU pose through T_imu_lidar: 6 residuals [rotation, translation].
+class LidarPoseFactor final : public ceres::SizedCostFunction<6, 7> {
+ public:
+  LidarPoseFactor(const Eigen::Isometry3d& T_map_lidar, const Eigen::Isometry3d& T_imu_lidar,
+                  const Eigen::Matrix<double, 6, 6>& information);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Vector3d p_meas_;
+  Eigen::Matrix3d R_meas_;
+  Eigen::Vector3d p_il_;
+  Eigen::Matrix3d R_il_;
+  Eigen::Matrix<double, 6, 6> sqrt_info_;
+};
+
+}  // namespace posed::estimator

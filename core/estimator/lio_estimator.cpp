@@ -1,0 +1,406 @@
+#include "core/estimator/lio_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/math/so3.hpp"
+
+namespace posed::estimator {
+namespace {
+
+SlidingWindowConfig window_config(const LioConfig& c) {
+  SlidingWindowConfig w = c.window;
+  w.gravity_mps2 = c.gravity_mps2;
+  w.noise = c.noise;
+  w.T_imu_lidar = c.T_imu_lidar;
+  return w;
+}
+
+Eigen::Isometry3d pose_of(const imu::ImuState& s) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = s.q_map_imu.toRotationMatrix();
+  T.translation() = s.p_map_imu_m;
+  return T;
+}
+
+}  // namespace
+
+LioEstimator::LioEstimator(const LioConfig& config)
+    : config_(config),
+      alignment_(config.alignment),
+      moving_alignment_(imu::MovingAlignmentConfig{.gravity_mps2 = config.gravity_mps2}),
+      // 20 s at 200 Hz: room for the lag of the slowest scan and a stalled consumer.
+      imu_(ImuBufferConfig{.capacity = 4000}),
+      gate_(MeasurementGateConfig{.pending_capacity = 8}),
+      lidar_(config.lidar),
+      window_(window_config(config)) {
+  bundle_imu_.reserve(imu_.capacity());
+  scratch_.reserve(imu_.capacity());
+}
+
+FusionFigures LioEstimator::figures() const {
+  FusionFigures f = figures_;
+  f.keyframes = lidar_.counters().keyframes;
+  if (anchor_) {
+    f.gyro_bias_radps = anchor_->bias.gyro_radps;
+    f.accel_bias_mps2 = anchor_->bias.accel_mps2;
+  } else if (aligned_) {
+    f.gyro_bias_radps = aligned_->gyro_bias_radps;
+  }
+  return f;
+}
+
+NavState LioEstimator::to_nav_state(const imu::ImuState& s, const Eigen::Vector3d& w_body,
+                                    bool optimised, const Eigen::Matrix<double, 6, 6>& cov) const {
+  NavState out;
+  out.stamp = s.stamp;
+  out.p_map_base_m = s.p_map_imu_m;
+  out.q_map_base = s.q_map_imu;
+  out.v_map_mps = s.v_map_mps;
+  out.w_base_radps = w_body;
+  // Tangent [dp map, dtheta body] to ROS order (position, rotation about map-fixed axes).
+  const Eigen::Matrix3d R = s.q_map_imu.toRotationMatrix();
+  out.pose_covariance.topLeftCorner<3, 3>() = cov.topLeftCorner<3, 3>();
+  out.pose_covariance.topRightCorner<3, 3>() = cov.topRightCorner<3, 3>() * R.transpose();
+  out.pose_covariance.bottomLeftCorner<3, 3>() = R * cov.bottomLeftCorner<3, 3>();
+  out.pose_covariance.bottomRightCorner<3, 3>() = R * cov.bottomRightCorner<3, 3>() * R.transpose();
+  const double sg = config_.noise.gyro_noise_density;
+  out.twist_covariance.setZero();
+  out.twist_covariance.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * 0.01;  // ~0.1 m/s
+  // Rate noise over a 200 Hz sample.
+  out.twist_covariance.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * sg * sg * 200.0;
+  out.mode = mode_;
+  out.optimised = optimised;
+  out.sequence = 0;
+  return out;
+}
+
+void LioEstimator::add_imu(const ImuSample& sample, std::vector<NavState>& states) {
+  const ImuPushResult pushed = imu_.push(sample);
+  if (pushed != ImuPushResult::kAccepted && pushed != ImuPushResult::kAcceptedOverwrote) return;
+  if (!aligned_) {
+    if (!first_imu_) first_imu_ = sample.stamp;
+    std::optional<imu::StaticAlignmentResult> r = alignment_.add(sample);
+    const std::optional<imu::StaticAlignmentResult> moving = moving_alignment_.add(sample);
+    if (!r && moving && sample.stamp - *first_imu_ >= config_.moving_alignment_after) {
+      r = moving;
+      aligned_moving_ = true;
+    }
+    if (r) {
+      aligned_ = r;
+      imu::ImuState start;
+      start.stamp = r->stamp;
+      start.q_map_imu = r->q_map_imu;
+      start.bias.gyro_radps = r->gyro_bias_radps;
+      anchor_ = start;
+      anchor_cov_.setZero();
+      anchor_cov_.block<2, 2>(3, 3) =
+          Eigen::Matrix2d::Identity() * r->tilt_sigma_rad * r->tilt_sigma_rad;
+      anchor_cov_(5, 5) = 1e-6;
+      propagated_ = start;
+      propagated_last_ = sample;
+      mode_ = EstimatorMode::kLidarInertial;
+    }
+    return;
+  }
+  // Odometry: one midpoint step from the previous sample with the anchor's biases.
+  if (propagated_last_ && sample.stamp > propagated_last_->stamp) {
+    imu::Preintegration step(imu::ImuNoise{}, propagated_.bias, propagated_last_->stamp);
+    step.add(*propagated_last_);
+    step.add(sample);
+    const HostTime stamp = sample.stamp;
+    propagated_ = step.predict(propagated_, config_.gravity_mps2);
+    propagated_.stamp = stamp;
+    propagated_last_ = sample;
+    // Uncertainty grows from the anchor's with the IMU's white noise (random-walk model).
+    Eigen::Matrix<double, 6, 6> cov = anchor_cov_;
+    const double dt = (stamp - anchor_->stamp).seconds();
+    const double sa = config_.noise.accel_noise_density, sg = config_.noise.gyro_noise_density;
+    cov.topLeftCorner<3, 3>().diagonal().array() += sa * sa * dt * dt * dt / 3.0;
+    cov.bottomRightCorner<3, 3>().diagonal().array() += sg * sg * dt;
+    NavState s = to_nav_state(
+        propagated_, sample.angular_velocity_radps - propagated_.bias.gyro_radps, false, cov);
+    s.sequence = ++sequence_;
+    states.push_back(s);
+  }
+  release_scans(states);
+}
+
+void LioEstimator::add_scan(LidarScan scan, std::vector<NavState>& states) {
+  if (!aligned_ || scan.end_stamp <= aligned_->stamp) {
+    ++figures_.scans_skipped;  // the map starts once the IMU has aligned; this scan is before
+    return;
+  }
+  gate_.push(std::move(scan));
+  release_scans(states);
+}
+
+void LioEstimator::release_scans(std::vector<NavState>& states) {
+  while (auto bundle = gate_.pop_ready(imu_, bundle_imu_)) process_scan(*bundle, states);
+  // IMU older than what the window and the waiting scans need is no longer useful.
+  HostTime keep_from = anchor_ ? anchor_->stamp : imu_.newest_stamp();
+  if (const auto oldest = gate_.oldest_needed()) keep_from = std::min(keep_from, *oldest);
+  if (!imu_.empty()) imu_.discard_before(keep_from - Duration::from_ms(50));
+}
+
+LioEstimator::Integrated LioEstimator::integrate(const imu::ImuState& from, HostTime t,
+                                                 lidar::ScanMotion* motion) {
+  Integrated out{imu::Preintegration(config_.noise, from.bias, from.stamp), false};
+  imu_.samples_between(from.stamp, t, scratch_);
+  if (scratch_.size() < 2) return out;
+  if (motion != nullptr) motion->clear();
+  std::vector<std::pair<HostTime, Eigen::Isometry3d>> lidar_poses;
+  const auto record = [&] {
+    if (motion == nullptr) return;
+    const imu::ImuState s = out.pre.predict(from, config_.gravity_mps2);
+    lidar_poses.emplace_back(out.pre.end(), pose_of(s) * config_.T_imu_lidar);
+  };
+  // Start exactly at `from`: interpolate between the bracket below it and the next sample.
+  std::size_t i = 0;
+  if (scratch_[0].stamp < from.stamp) {
+    out.pre.add(imu::interpolate_sample(scratch_[0], scratch_[1], from.stamp));
+    i = 1;
+  } else {
+    out.pre.add(scratch_[0]);
+    i = 1;
+  }
+  const bool starts_covered = scratch_[0].stamp <= from.stamp;
+  record();
+  for (; i < scratch_.size(); ++i) {
+    if (scratch_[i].stamp >= t) {
+      out.pre.add_until(t, scratch_[i]);
+      record();
+      out.covered = starts_covered;
+      break;
+    }
+    out.pre.add(scratch_[i]);
+    record();
+  }
+  if (motion != nullptr && !lidar_poses.empty()) {
+    const Eigen::Isometry3d T_end_inv = lidar_poses.back().second.inverse();
+    for (const auto& [stamp, T] : lidar_poses) {
+      motion->stamps.push_back(stamp);
+      motion->T_end_t.push_back(T_end_inv * T);
+    }
+  }
+  return out;
+}
+
+void LioEstimator::reanchor_propagation(const imu::ImuState& state) {
+  anchor_ = state;
+  propagated_ = state;
+  propagated_last_.reset();
+  // Re-propagate through the samples already past the anchor (they were published from the old
+  // anchor; the next ones continue from the corrected state).
+  imu_.samples_between(state.stamp, imu_.newest_stamp(), scratch_);
+  if (scratch_.size() < 2) return;
+  std::optional<ImuSample> previous;
+  for (std::size_t i = 0; i < scratch_.size(); ++i) {
+    const ImuSample& s = scratch_[i];
+    if (!previous) {
+      previous = s.stamp < state.stamp && i + 1 < scratch_.size()
+                     ? imu::interpolate_sample(s, scratch_[i + 1], state.stamp)
+                     : s;
+      continue;
+    }
+    if (s.stamp <= previous->stamp) continue;
+    imu::Preintegration step(imu::ImuNoise{}, propagated_.bias, previous->stamp);
+    step.add(*previous);
+    step.add(s);
+    propagated_ = step.predict(propagated_, config_.gravity_mps2);
+    propagated_.stamp = s.stamp;
+    previous = s;
+  }
+  propagated_last_ = previous;
+}
+
+bool LioEstimator::diverged(const imu::ImuState& s) const {
+  return s.v_map_mps.norm() > config_.max_speed_mps ||
+         s.bias.gyro_radps.norm() > config_.max_gyro_bias_radps ||
+         s.bias.accel_mps2.norm() > config_.max_accel_bias_mps2 || !s.p_map_imu_m.allFinite() ||
+         !s.q_map_imu.coeffs().allFinite();
+}
+
+void LioEstimator::reinitialise(const imu::ImuState& at, const Eigen::Vector3d& v_map_mps) {
+  ++figures_.reinitialisations;
+  mode_ = EstimatorMode::kReinitialising;
+  imu::ImuState s = at;
+  s.v_map_mps = v_map_mps;
+  // Biases back to what the start-up alignment found: the window's may be what diverged.
+  s.bias.gyro_radps = aligned_ ? aligned_->gyro_bias_radps : Eigen::Vector3d::Zero();
+  s.bias.accel_mps2.setZero();
+  Eigen::Matrix<double, 15, 1> sigma;
+  sigma << Eigen::Vector3d::Constant(0.05), Eigen::Vector3d::Constant(0.02),
+      Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(0.02),
+      Eigen::Vector3d::Constant(0.3);
+  window_.reset(s, sigma);
+}
+
+bool LioEstimator::plausible(const lidar::ScanMatchResult& match,
+                             const Eigen::Isometry3d& T_predicted) const {
+  if (!match.ok) return false;
+  const double jump_m = (match.T_map_lidar.translation() - T_predicted.translation()).norm();
+  const double jump_rad =
+      so3::log(Eigen::Matrix3d(T_predicted.linear().transpose() * match.T_map_lidar.linear()))
+          .norm();
+  return jump_m <= config_.max_match_jump_m && jump_rad <= config_.max_match_jump_rad;
+}
+
+std::optional<LioEstimator::LidarPrediction> LioEstimator::constant_velocity(HostTime t) const {
+  if (!matched_[0] || !matched_[1] || matched_[1]->first <= matched_[0]->first ||
+      t <= matched_[1]->first) {
+    return std::nullopt;
+  }
+  const auto& [t0, T0] = *matched_[0];
+  const auto& [t1, T1] = *matched_[1];
+  const double dt01 = (t1 - t0).seconds();
+  if (dt01 > 1.0) return std::nullopt;  // too old to extrapolate
+  // The body twist between the last two matches, held.
+  const Eigen::Isometry3d delta = T0.inverse() * T1;
+  const Eigen::Vector3d w = so3::log(Eigen::Matrix3d(delta.linear())) / dt01;
+  const Eigen::Vector3d v = delta.translation() / dt01;
+  const auto at = [&](HostTime s) {
+    const double dt = (s - t1).seconds();
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    step.linear() = so3::exp(w * dt);
+    step.translation() = v * dt;
+    return T1 * step;
+  };
+  LidarPrediction p;
+  p.T_map_lidar = at(t);
+  p.v_map_mps = T1.linear() * v;
+  const Eigen::Isometry3d T_end_inv = p.T_map_lidar.inverse();
+  for (HostTime s = t1; s < t; s += Duration::from_ms(10)) {
+    p.motion.stamps.push_back(s);
+    p.motion.T_end_t.push_back(T_end_inv * at(s));
+  }
+  p.motion.stamps.push_back(t);
+  p.motion.T_end_t.push_back(Eigen::Isometry3d::Identity());
+  return p;
+}
+
+Eigen::Vector3d LioEstimator::lidar_velocity_or_zero(HostTime t) const {
+  const auto cv = constant_velocity(t);
+  return cv ? cv->v_map_mps : Eigen::Vector3d::Zero();
+}
+
+imu::ImuState LioEstimator::imu_state_at(const Eigen::Isometry3d& T_map_lidar, HostTime t) const {
+  const Eigen::Isometry3d T_imu = T_map_lidar * config_.T_imu_lidar.inverse();
+  imu::ImuState s;
+  s.stamp = t;
+  s.p_map_imu_m = T_imu.translation();
+  s.q_map_imu = Eigen::Quaterniond(T_imu.linear()).normalized();
+  return s;
+}
+
+void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<NavState>& states) {
+  const LidarScan& scan = bundle.measurement;
+  const HostTime t = scan.end_stamp;
+  if (bundle.kind == ReleaseKind::kDrained || !anchor_ || t <= anchor_->stamp) {
+    ++figures_.scans_skipped;  // no IMU up to its end, or older than the state already estimated
+    return;
+  }
+  const imu::ImuState from = window_.empty() ? *anchor_ : window_.latest();
+  begin(LioStep::kPredict);
+  Integrated integrated = integrate(from, t, &motion_);
+  end(LioStep::kPredict);
+  if (!integrated.covered || integrated.pre.empty()) {
+    ++figures_.scans_skipped;
+    return;
+  }
+  imu::ImuState predicted = integrated.pre.predict(from, config_.gravity_mps2);
+  predicted.stamp = t;
+  const Eigen::Isometry3d T_pred = pose_of(predicted) * config_.T_imu_lidar;
+
+  const auto points = scan.points.as<LidarPoint>();
+  const std::span<const LidarPoint> point_span(points.data(), scan.point_count);
+  begin(LioStep::kDeskew);
+  lidar_.deskew(point_span, scan.start_stamp, motion_);
+  end(LioStep::kDeskew);
+  begin(LioStep::kFeatures);
+  lidar_.extract_features();
+  end(LioStep::kFeatures);
+  begin(LioStep::kMatch);
+  lidar::ScanMatchResult match = lidar_.match(T_pred);
+  end(LioStep::kMatch);
+  figures_.degenerate_directions = match.degenerate_directions;
+
+  // A match far from the prediction is more likely a wrong basin than the truth. When it is the
+  // IMU's prediction that led nowhere (a faulty or saturated IMU), the lidar alone may still
+  // know: retry from its constant-velocity prediction, deskewed with that motion.
+  bool imu_suspect = false;
+  std::optional<Eigen::Vector3d> lidar_velocity;
+  if (!window_.empty() && !plausible(match, T_pred)) {
+    match.ok = false;
+    if (const auto cv = constant_velocity(t)) {
+      lidar_.deskew(point_span, scan.start_stamp, cv->motion);
+      lidar_.extract_features();
+      lidar::ScanMatchResult retry = lidar_.match(cv->T_map_lidar);
+      if (plausible(retry, cv->T_map_lidar)) {
+        match = retry;
+        imu_suspect = true;
+        lidar_velocity = cv->v_map_mps;
+      }
+    }
+  }
+  if (!match.ok) ++figures_.scans_rejected;
+  if (match.ok && match.degenerate_directions > 0) ++figures_.scans_degenerate;
+
+  begin(LioStep::kWindow);
+  if (window_.empty()) {
+    // The first scan defines the map at the aligned IMU pose. Position and yaw are the map's
+    // definition; tilt, velocity and gyro bias are as certain as the alignment made them.
+    Eigen::Matrix<double, 15, 1> sigma;
+    const double tilt = std::max(aligned_->tilt_sigma_rad, 1e-3);
+    sigma << Eigen::Vector3d::Constant(1e-3), tilt, tilt, 1e-4,
+        Eigen::Vector3d::Constant(aligned_moving_ ? 5.0 : 0.05),
+        Eigen::Vector3d::Constant(aligned_moving_ ? 0.02 : 0.01), Eigen::Vector3d::Constant(0.2);
+    window_.reset(predicted, sigma);
+  } else if (imu_suspect) {
+    // The IMU contradicts the lidar: its preintegration cannot join the window.
+    reinitialise(imu_state_at(match.T_map_lidar, t), *lidar_velocity);
+  } else {
+    std::optional<LidarPose> lidar_factor;
+    if (match.ok) lidar_factor = LidarPose{match.T_map_lidar_measured, match.information};
+    window_.add(predicted, integrated.pre, lidar_factor);
+    window_.solve();
+  }
+  imu::ImuState estimate = window_.latest();
+  if (!imu_suspect) {
+    mode_ = match.ok && match.degenerate_directions > 0 ? EstimatorMode::kDegenerate
+                                                        : EstimatorMode::kLidarInertial;
+  }
+  if (diverged(estimate)) {
+    // Restart from the lidar's pose: this scan's when it matched, else where the lidar's own
+    // motion says; only without either from where the IMU says.
+    if (match.ok) {
+      reinitialise(imu_state_at(match.T_map_lidar, t), lidar_velocity_or_zero(t));
+    } else if (const auto cv = constant_velocity(t)) {
+      reinitialise(imu_state_at(cv->T_map_lidar, t), cv->v_map_mps);
+    } else {
+      reinitialise(predicted, Eigen::Vector3d::Zero());
+    }
+    estimate = window_.latest();
+  }
+  end(LioStep::kWindow);
+  begin(LioStep::kMapUpdate);
+  if (match.ok) {
+    ++figures_.scans_used;
+    const Eigen::Isometry3d T_map_lidar = pose_of(estimate) * config_.T_imu_lidar;
+    matched_[0] = matched_[1];
+    matched_[1] = {t, T_map_lidar};
+    lidar_.commit(T_map_lidar);
+  }
+  anchor_cov_ = window_.size() > 1 ? window_.latest_pose_covariance()
+                                   : Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  reanchor_propagation(estimate);
+  end(LioStep::kMapUpdate);
+
+  const ImuSample& last = bundle_imu_.empty() ? ImuSample{} : bundle_imu_.back();
+  NavState s = to_nav_state(estimate, last.angular_velocity_radps - estimate.bias.gyro_radps, true,
+                            anchor_cov_);
+  s.sequence = ++sequence_;
+  states.push_back(s);
+}
+
+}  // namespace posed::estimator

@@ -1,0 +1,156 @@
+#pragma once
+// The lidar-inertial estimator (seed 000 §2.3, seed 001; LIO-SAM's loosely coupled factor graph
+// on a fixed lag): a FusionCore fed IMU samples and VLP-32C scans in stamp order.
+//
+//   start-up   the rig stands still: static alignment (roll, pitch, gyro bias); the map frame is
+//              the IMU at that moment, yaw 0. A rig already moving is aligned from its mean
+//              rotation-compensated specific force after `moving_alignment_after`, starting
+//              with wide priors on tilt, velocity and gyro bias that the window narrows.
+//   per scan   released by the MeasurementGate once the IMU covers its last firing; the IMU is
+//              preintegrated from the previous state to the scan's end; the prediction deskews the
+//              scan and seeds scan-to-map; the window gets the state with its preintegration and
+//              lidar pose factors and is optimised; the scan joins the map at the optimised pose;
+//              the optimised state is published (rt/posed/pose).
+//   per IMU    propagation from the newest optimised state (rt/posed/odom, low latency).
+//   divergence speed, bias or pose-jump limits exceeded: the window restarts from the last good
+//              lidar pose (counted, mode kReinitialising); the map is kept.
+//
+// Deterministic, no threads, no clocks (core/ rules).
+
+#include <array>
+#include <optional>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/estimator/fusion_core.hpp"
+#include "core/estimator/sliding_window.hpp"
+#include "core/imu/moving_alignment.hpp"
+#include "core/imu/preintegration.hpp"
+#include "core/imu/static_alignment.hpp"
+#include "core/lidar/lidar_odometry.hpp"
+#include "core/sync/imu_buffer.hpp"
+#include "core/sync/measurement_gate.hpp"
+
+namespace posed::estimator {
+
+struct LioConfig {
+  double gravity_mps2 = 9.805;
+  imu::ImuNoise noise;
+  imu::StaticAlignmentConfig alignment;
+  /// without a still window by then, align while moving (MovingAlignment) [ns]
+  Duration moving_alignment_after = Duration::from_s(3);
+  /// the lidar in the IMU (base_link) frame
+  Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
+  lidar::LidarOdometryConfig lidar;
+  SlidingWindowConfig window;  ///< gravity, noise and T_imu_lidar are copied in from above
+  // Divergence limits: beyond any of them the estimate is not trusted.
+  double max_speed_mps = 40.0;       ///< [m/s]
+  double max_gyro_bias_radps = 0.3;  ///< [rad/s]
+  double max_accel_bias_mps2 = 2.0;  ///< [m/s^2]
+  /// a scan match this far from the IMU prediction is refused rather than believed [m]
+  double max_match_jump_m = 1.0;
+  double max_match_jump_rad = 0.2;  ///< [rad]
+};
+
+/// The steps of one scan, for profilers (`posectl bench lio`): the estimator calls the probe at
+/// each step's start and end; it reads no clock itself.
+enum class LioStep : std::uint8_t {
+  kPredict,    ///< IMU preintegration to the scan's end, deskew motion
+  kDeskew,     ///< points into the frame at the scan's end
+  kFeatures,   ///< range image, ground, edges and planes
+  kMatch,      ///< scan-to-map
+  kWindow,     ///< fixed-lag window: add, solve, marginalise
+  kMapUpdate,  ///< the scan into the map, covariance, re-propagation
+};
+inline constexpr std::array<std::string_view, 6> kLioStepNames = {
+    "predict", "deskew", "features", "match", "window", "map_update"};
+
+class LioStepProbe {
+ public:
+  virtual ~LioStepProbe() = default;
+  virtual void begin(LioStep step) = 0;
+  virtual void end(LioStep step) = 0;
+};
+
+class LioEstimator final : public FusionCore {
+ public:
+  explicit LioEstimator(const LioConfig& config);
+  /// Optional: called around every step of every scan (null: none).
+  void set_probe(LioStepProbe* probe) { probe_ = probe; }
+
+  void add_imu(const ImuSample& sample, std::vector<NavState>& states) override;
+  void add_scan(LidarScan scan, std::vector<NavState>& states) override;
+  EstimatorMode mode() const override { return mode_; }
+  std::string_view description() const override {
+    return "lidar-inertial (scan-to-map with degeneracy handling, IMU preintegration, fixed-lag "
+           "window)";
+  }
+  FusionFigures figures() const override;
+
+  const lidar::LidarOdometry& lidar_odometry() const { return lidar_; }
+  const SlidingWindow& window() const { return window_; }
+
+ private:
+  struct Integrated {
+    imu::Preintegration pre;
+    bool covered = false;  ///< the IMU reached both ends
+  };
+  void release_scans(std::vector<NavState>& states);
+  void process_scan(const Bundle<LidarScan>& bundle, std::vector<NavState>& states);
+  /// Preintegrates the held IMU from `from` (its stamp and biases) to `t`, filling the deskew
+  /// motion of the lidar over [from.stamp, t] when `motion` is given.
+  Integrated integrate(const imu::ImuState& from, HostTime t, lidar::ScanMotion* motion);
+  void reanchor_propagation(const imu::ImuState& state);
+  NavState to_nav_state(const imu::ImuState& s, const Eigen::Vector3d& w_body, bool optimised,
+                        const Eigen::Matrix<double, 6, 6>& cov_tangent) const;
+  bool diverged(const imu::ImuState& s) const;
+  /// Restarts the window at `at` (pose) with `v_map_mps` and the start-up biases; counted.
+  void reinitialise(const imu::ImuState& at, const Eigen::Vector3d& v_map_mps);
+  /// A match close enough to the prediction to be believed.
+  bool plausible(const lidar::ScanMatchResult& match, const Eigen::Isometry3d& T_predicted) const;
+  /// The lidar's own prediction for `t`: the last two matched poses' twist held (no IMU).
+  struct LidarPrediction {
+    Eigen::Isometry3d T_map_lidar;
+    Eigen::Vector3d v_map_mps;
+    lidar::ScanMotion motion;  ///< over [last match, t], for deskew
+  };
+  std::optional<LidarPrediction> constant_velocity(HostTime t) const;
+  Eigen::Vector3d lidar_velocity_or_zero(HostTime t) const;
+  /// The IMU state (pose only) whose lidar is at T_map_lidar.
+  imu::ImuState imu_state_at(const Eigen::Isometry3d& T_map_lidar, HostTime t) const;
+
+  LioConfig config_;
+  imu::StaticAlignment alignment_;
+  imu::MovingAlignment moving_alignment_;
+  std::optional<HostTime> first_imu_;
+  std::optional<imu::StaticAlignmentResult> aligned_;
+  bool aligned_moving_ = false;  ///< velocity and gyro bias unknown at start
+  ImuBuffer imu_;
+  MeasurementGate<LidarScan> gate_;
+  std::vector<ImuSample> bundle_imu_;
+  std::vector<ImuSample> scratch_;
+  lidar::LidarOdometry lidar_;
+  lidar::ScanMotion motion_;
+  SlidingWindow window_;
+  /// the state published poses are propagated from (the newest optimised one)
+  std::optional<imu::ImuState> anchor_;
+  Eigen::Matrix<double, 6, 6> anchor_cov_ = Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
+  /// IMU propagation for odom: from the anchor through every sample since
+  imu::ImuState propagated_;
+  std::optional<ImuSample> propagated_last_;
+  /// the last two matched lidar poses (stamp, T_map_lidar), oldest first
+  std::array<std::optional<std::pair<HostTime, Eigen::Isometry3d>>, 2> matched_;
+  EstimatorMode mode_ = EstimatorMode::kAligning;
+  FusionFigures figures_;
+  std::uint64_t sequence_ = 0;
+  LioStepProbe* probe_ = nullptr;
+  void begin(LioStep s) {
+    if (probe_ != nullptr) probe_->begin(s);
+  }
+  void end(LioStep s) {
+    if (probe_ != nullptr) probe_->end(s);
+  }
+};
+
+}  // namespace posed::estimator

@@ -1,0 +1,104 @@
+// The analytic Jacobians of the window's factors against Ceres's numeric differentiation, at
+// states away from the measurements (so every term of the residuals is non-zero).
+
+#include "core/estimator/factors.hpp"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include "core/estimator/pose_manifold.hpp"
+#include "tests/unit/estimator/analytic_motion.hpp"
+
+namespace posed::estimator {
+namespace {
+
+void state_arrays(const imu::ImuState& s, double* pose, double* sb) {
+  for (int i = 0; i < 3; ++i) {
+    pose[i] = s.p_map_imu_m[i];
+    sb[i] = s.v_map_mps[i];
+    sb[3 + i] = s.bias.gyro_radps[i];
+    sb[6 + i] = s.bias.accel_mps2[i];
+  }
+  const Eigen::Quaterniond q = s.q_map_imu.normalized();
+  pose[3] = q.x();
+  pose[4] = q.y();
+  pose[5] = q.z();
+  pose[6] = q.w();
+}
+
+/// Every Jacobian entry (in the tangent spaces) agrees with numeric differentiation to `tol`
+/// relative to its size (absolute below 1): GradientChecker's own verdict flags two zeros that
+/// differ by rounding.
+void expect_jacobians_match(const ceres::GradientChecker::ProbeResults& r, double tol) {
+  ASSERT_EQ(r.local_jacobians.size(), r.local_numeric_jacobians.size());
+  for (std::size_t b = 0; b < r.local_jacobians.size(); ++b) {
+    const Eigen::MatrixXd& a = r.local_jacobians[b];
+    const Eigen::MatrixXd& n = r.local_numeric_jacobians[b];
+    for (Eigen::Index i = 0; i < a.rows(); ++i) {
+      for (Eigen::Index k = 0; k < a.cols(); ++k) {
+        EXPECT_NEAR(a(i, k), n(i, k), tol * std::max(1.0, std::abs(n(i, k))))
+            << "block " << b << " row " << i << " col " << k;
+      }
+    }
+  }
+}
+
+TEST(Factors, ImuFactorJacobiansMatchNumericDifferentiation) {
+  const test::AnalyticMotion m;
+  imu::ImuBias lin;
+  lin.gyro_radps = {0.01, -0.02, 0.005};
+  lin.accel_mps2 = {0.05, 0.02, -0.04};
+  imu::Preintegration pre({2e-3, 3e-2, 1e-5, 1e-3}, lin, HostTime::from_ns(0));
+  for (int k = 0; k <= 40; ++k) pre.add(m.sample(1.0 + k / 200.0));
+  const ImuFactor factor(pre, m.gravity_mps2, {2e-3, 3e-2, 1e-5, 1e-3});
+
+  imu::ImuState i = m.state(1.0), j = m.state(1.2);
+  i.p_map_imu_m += Eigen::Vector3d(0.1, -0.05, 0.02);
+  i.q_map_imu = i.q_map_imu * so3::exp_q(Eigen::Vector3d(0.02, -0.01, 0.03));
+  j.v_map_mps += Eigen::Vector3d(0.05, 0.1, -0.02);
+  i.bias.gyro_radps = {0.012, -0.018, 0.004};
+  i.bias.accel_mps2 = {0.06, 0.01, -0.03};
+  j.bias = i.bias;
+  j.bias.accel_mps2.x() += 0.01;
+  double pose_i[7], sb_i[9], pose_j[7], sb_j[9];
+  state_arrays(i, pose_i, sb_i);
+  state_arrays(j, pose_j, sb_j);
+  const double* params[] = {pose_i, sb_i, pose_j, sb_j};
+
+  PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, &pose_manifold,
+                                                         nullptr};
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, 1e-5, &results);
+  expect_jacobians_match(results, 1e-5);
+}
+
+TEST(Factors, LidarPoseFactorJacobiansMatchNumericDifferentiation) {
+  Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
+  T_imu_lidar.linear() = so3::exp(Eigen::Vector3d(0.01, 0.02, -0.5));
+  T_imu_lidar.translation() = Eigen::Vector3d(0.27, -0.01, 0.18);
+  Eigen::Isometry3d T_meas = Eigen::Isometry3d::Identity();
+  T_meas.linear() = so3::exp(Eigen::Vector3d(0.1, -0.2, 1.0));
+  T_meas.translation() = Eigen::Vector3d(3, -2, 0.5);
+  Eigen::Matrix<double, 6, 6> info = Eigen::Matrix<double, 6, 6>::Identity() * 100;
+  info(0, 4) = info(4, 0) = 20;  // correlated, as a scan's information is
+  const LidarPoseFactor factor(T_meas, T_imu_lidar, info);
+  imu::ImuState s;
+  s.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.12, -0.18, 0.45)));
+  s.p_map_imu_m = Eigen::Vector3d(3.1, -2.2, 0.4);
+  double pose[7], sb[9];
+  state_arrays(s, pose, sb);
+  const double* params[] = {pose};
+  PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold};
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, 1e-6, &results);
+  expect_jacobians_match(results, 1e-6);
+}
+
+}  // namespace
+}  // namespace posed::estimator
