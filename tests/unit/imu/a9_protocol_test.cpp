@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "tests/unit/imu/realdata.hpp"
+#include "tests/common/realdata.hpp"
 
 namespace posed::drivers::a9 {
 namespace {

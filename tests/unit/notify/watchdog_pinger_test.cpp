@@ -8,7 +8,9 @@
 #include "daemon/notify/stage_watchdog.hpp"
 
 namespace posed::notify {
-namespace {
+// Named rather than anonymous: test binaries build as unity batches, where another file's
+// helpers of the same name share the translation unit.
+namespace watchdog_pinger_test {
 
 const HostTime kStart = HostTime::from_ns(500'000'000'000);
 
@@ -129,5 +131,5 @@ TEST(WatchdogPinger, SystemdRestartsOnlyWhenAStageStalls) {
   }
 }
 
-}  // namespace
+}  // namespace watchdog_pinger_test
 }  // namespace posed::notify

@@ -9,7 +9,9 @@
 #include "core/sync/simulated_clock.hpp"
 
 namespace posed {
-namespace {
+// Named rather than anonymous: test binaries build as unity batches, where another file's
+// helpers of the same name share the translation unit.
+namespace clockless_stamper_test {
 
 /// The PLUG 617 over UVC: 25 Hz, no clock, 12 ms minimum latency, 2 ms of one-sided jitter.
 SimulatedStreamConfig thermal_camera(std::uint64_t seed) {
@@ -142,5 +144,5 @@ TEST(ClocklessStamper, WithoutARateStampsAreArrivalMinusLatencyAndCounted) {
   EXPECT_EQ(stamper.status().rejected, 2u);
 }
 
-}  // namespace
+}  // namespace clockless_stamper_test
 }  // namespace posed

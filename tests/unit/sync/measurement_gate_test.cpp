@@ -10,7 +10,9 @@
 #include "core/payload_pool.hpp"
 
 namespace posed {
-namespace {
+// Named rather than anonymous: test binaries build as unity batches, where another file's
+// helpers of the same name share the translation unit.
+namespace measurement_gate_test {
 
 HostTime ms(std::int64_t v) { return HostTime::from_ns(Duration::from_ms(v).ns); }
 HostTime us(std::int64_t v) { return HostTime::from_ns(Duration::from_us(v).ns); }
@@ -338,5 +340,5 @@ TEST(MeasurementGate, OldestNeededTracksPendingSpansAndTheLastRelease) {
   EXPECT_EQ(gate.oldest_needed(), ms(200));
 }
 
-}  // namespace
+}  // namespace measurement_gate_test
 }  // namespace posed

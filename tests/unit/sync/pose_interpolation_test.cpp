@@ -6,7 +6,9 @@
 #include <numbers>
 
 namespace posed {
-namespace {
+// Named rather than anonymous: test binaries build as unity batches, where another file's
+// helpers of the same name share the translation unit.
+namespace pose_interpolation_test {
 
 HostTime ms(std::int64_t v) { return HostTime::from_ns(Duration::from_ms(v).ns); }
 
@@ -152,5 +154,5 @@ TEST(PoseHistory, DropsOutOfOrderPosesAndAnswersFromASinglePose) {
   EXPECT_EQ(history.size(), 1u);
 }
 
-}  // namespace
+}  // namespace pose_interpolation_test
 }  // namespace posed

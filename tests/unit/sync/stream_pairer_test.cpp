@@ -12,7 +12,9 @@
 #include "core/payload_pool.hpp"
 
 namespace posed {
-namespace {
+// Named rather than anonymous: test binaries build as unity batches, where another file's
+// helpers of the same name share the translation unit.
+namespace stream_pairer_test {
 
 HostTime ms(std::int64_t v) { return HostTime::from_ns(Duration::from_ms(v).ns); }
 HostTime us(std::int64_t v) { return HostTime::from_ns(Duration::from_us(v).ns); }
@@ -291,5 +293,5 @@ TEST(StreamPairer, OverflowDropsTheOldestPendingFrame) {
   EXPECT_EQ(out[1].visible->id, 3);
 }
 
-}  // namespace
+}  // namespace stream_pairer_test
 }  // namespace posed

@@ -9,7 +9,7 @@
 #include <numbers>
 
 #include "drivers/velodyne/calibration_loader.hpp"
-#include "tests/unit/velodyne/realdata.hpp"
+#include "tests/common/realdata.hpp"
 
 namespace posed::drivers::velodyne {
 namespace {

@@ -15,8 +15,8 @@
 
 #include "drivers/velodyne/calibration_loader.hpp"
 #include "drivers/velodyne/packet_decoder.hpp"
+#include "tests/common/realdata.hpp"
 #include "tests/unit/velodyne/capture_fixture.hpp"
-#include "tests/unit/velodyne/realdata.hpp"
 
 namespace posed::drivers::velodyne {
 namespace {

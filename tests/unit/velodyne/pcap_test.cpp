@@ -10,7 +10,7 @@
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_source.hpp"
 #include "drivers/recording/pcap_udp.hpp"
-#include "tests/unit/velodyne/realdata.hpp"
+#include "tests/common/realdata.hpp"
 
 namespace posed::drivers::recording {
 namespace {
@@ -177,7 +177,7 @@ std::vector<std::vector<std::byte>> sample_payloads() {
 
 TEST(Pcap, RealVlp32cCapture) {
   POSED_REQUIRE_REALDATA(path, "velodyne_vlp32c/vlp32c_nebula_5scans.pcap");
-  const auto bytes = test::read_bytes(path);
+  const auto bytes = test::read_std_bytes(path);
   const Collected c = collect(bytes);
   EXPECT_EQ(c.end, PcapStatus::kEnd);
   EXPECT_EQ(c.end_offset, bytes.size());
@@ -191,7 +191,7 @@ TEST(Pcap, RealVlp32cCapture) {
 
 TEST(Pcap, RealHdl32eCaptureHasDataAndPositionPackets) {
   POSED_REQUIRE_REALDATA(path, "velodyne_hdl32e/monterey-first-100-packets.pcap");
-  const auto bytes = test::read_bytes(path);
+  const auto bytes = test::read_std_bytes(path);
   const Collected c = collect(bytes);
   EXPECT_EQ(c.end, PcapStatus::kEnd);
   std::size_t data = 0, position = 0;
@@ -205,7 +205,7 @@ TEST(Pcap, RealHdl32eCaptureHasDataAndPositionPackets) {
 
 TEST(Pcap, TruncatedAnywhereReportsTheOffsetAndNeverOverreads) {
   POSED_REQUIRE_REALDATA(path, "velodyne_vlp32c/vlp32c_nebula_5scans.pcap");
-  const auto bytes = test::read_bytes(path);
+  const auto bytes = test::read_std_bytes(path);
   // Record k starts at 24 + k * (16 + 1248).
   for (std::size_t cut :
        {std::size_t{0}, std::size_t{3}, std::size_t{23}, std::size_t{24 + 10},
@@ -315,7 +315,7 @@ TEST(PcapSource, AsFastAsPossibleThenEndOfStream) {
 
 TEST(PcapSource, OriginalTimingIsPacedAndTruncationIsReported) {
   POSED_REQUIRE_REALDATA(path, "velodyne_hdl32e/monterey-first-100-packets.pcap");
-  const auto bytes = test::read_bytes(path);
+  const auto bytes = test::read_std_bytes(path);
   // The first 40 records plus half of one: the capture spans ~22 ms before the cut.
   const auto tmp = std::filesystem::temp_directory_path() /
                    ("posed_pcap_trunc_" + std::to_string(::getpid()) + ".pcap");

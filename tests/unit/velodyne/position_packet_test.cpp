@@ -6,8 +6,8 @@
 
 #include <cstring>
 
+#include "tests/common/realdata.hpp"
 #include "tests/unit/velodyne/capture_fixture.hpp"
-#include "tests/unit/velodyne/realdata.hpp"
 
 namespace posed::drivers::velodyne {
 namespace {

@@ -11,9 +11,9 @@
 
 #include "drivers/velodyne/calibration_loader.hpp"
 #include "drivers/velodyne/device_clock.hpp"
+#include "tests/common/realdata.hpp"
 #include "tests/unit/velodyne/capture_fixture.hpp"
 #include "tests/unit/velodyne/packet_builder.hpp"
-#include "tests/unit/velodyne/realdata.hpp"
 
 namespace posed::drivers::velodyne {
 namespace {

@@ -14,8 +14,8 @@
 #include <thread>
 
 #include "drivers/velodyne/packet_decoder.hpp"
+#include "tests/common/realdata.hpp"
 #include "tests/unit/velodyne/capture_fixture.hpp"
-#include "tests/unit/velodyne/realdata.hpp"
 
 namespace posed::drivers::velodyne {
 namespace {
