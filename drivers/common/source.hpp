@@ -65,6 +65,9 @@ class Source {
   /// Makes a blocked or later read() return kEndOfStream. Safe from any thread.
   virtual void request_stop() = 0;
   virtual SourceCounters counters() const = 0;
+  /// What the bytes of `channel` are (drivers/common/wire_format.hpp, or a camera pixel format);
+  /// empty for a channel this Source never produces. Stages choose their decoder by it.
+  virtual std::string_view wire_format(std::uint32_t channel) const = 0;
   /// Live: data arrives in real time and must never wait for the pipeline (queues drop the
   /// oldest). Not live (recordings, generators at full speed): nothing may be lost, so the
   /// pipeline blocks the Source instead, and results are deterministic.

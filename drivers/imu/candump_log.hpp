@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "drivers/common/source.hpp"
+#include "drivers/common/wire_format.hpp"
 #include "drivers/imu/can_frame.hpp"
 
 namespace posed::drivers::can {
@@ -37,6 +38,9 @@ class CandumpReplaySource final : public Source {
  public:
   explicit CandumpReplaySource(std::string path, std::string name = "imu_can");
   std::string_view name() const override { return name_; }
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return channel == 0 ? wire::kCanFrame : std::string_view{};
+  }
   bool open(std::string& error) override;
   ReadStatus read(RawChunk& chunk, Duration timeout) override;
   void request_stop() override { stop_ = true; }

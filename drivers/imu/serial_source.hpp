@@ -12,6 +12,7 @@
 
 #include "core/time.hpp"
 #include "drivers/common/source.hpp"
+#include "drivers/common/wire_format.hpp"
 
 namespace posed::drivers {
 
@@ -41,6 +42,9 @@ class SerialSource final : public Source {
   SerialSource& operator=(const SerialSource&) = delete;
 
   std::string_view name() const override { return config_.name; }
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return channel == 0 ? wire::kA9Serial : std::string_view{};
+  }
   bool open(std::string& error) override;
   /// kData, kTimeout, kEndOfStream (after request_stop), or kDeviceLost while the device is
   /// absent (the read then waits out the back-off, bounded by `timeout`, and retries itself).

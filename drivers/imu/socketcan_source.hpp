@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "drivers/common/source.hpp"
+#include "drivers/common/wire_format.hpp"
 #include "drivers/imu/can_frame.hpp"
 
 namespace posed::drivers::can {
@@ -52,6 +53,9 @@ class SocketCanSource final : public Source {
   SocketCanSource& operator=(const SocketCanSource&) = delete;
 
   std::string_view name() const override { return config_.name; }
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return channel == 0 ? wire::kCanFrame : std::string_view{};
+  }
   bool open(std::string& error) override;
   ReadStatus read(RawChunk& chunk, Duration timeout) override;
   void request_stop() override;

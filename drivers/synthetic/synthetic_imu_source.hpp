@@ -14,6 +14,7 @@
 
 #include "core/sim/circle_motion.hpp"
 #include "drivers/common/source.hpp"
+#include "drivers/common/wire_format.hpp"
 
 namespace posed::drivers {
 
@@ -44,6 +45,10 @@ class SyntheticImuSource final : public Source {
   void request_stop() override { stop_.store(true, std::memory_order_relaxed); }
   SourceCounters counters() const override;
   bool live() const override { return config_.real_time; }
+  /// the A9 serial wire format, as the real device
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return channel == 0 ? wire::kA9Serial : std::string_view{};
+  }
 
   /// Host time of the motion's t = 0 (valid after open()); the ground truth at host time h is
   /// motion().at(h - motion_start()).

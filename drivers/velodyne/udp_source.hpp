@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "drivers/common/source.hpp"
+#include "drivers/common/wire_format.hpp"
 
 namespace posed::drivers::velodyne {
 
@@ -57,6 +58,12 @@ class UdpSource final : public drivers::Source {
   UdpSource& operator=(const UdpSource&) = delete;
 
   std::string_view name() const override { return config_.name; }
+  /// channel 0: data port, 1: position port
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return channel == 0   ? wire::kVelodyneData
+           : channel == 1 ? wire::kVelodynePosition
+                          : std::string_view{};
+  }
   bool open(std::string& error) override;
   ReadStatus read(RawChunk& chunk, Duration timeout) override;
   void request_stop() override;
