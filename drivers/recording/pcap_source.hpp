@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "drivers/common/source.hpp"
+#include "drivers/common/wire_format.hpp"
 #include "drivers/recording/pcap_file.hpp"
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_udp.hpp"
@@ -44,6 +45,12 @@ class PcapSource final : public drivers::Source {
   explicit PcapSource(PcapSourceConfig config);
 
   std::string_view name() const override { return config_.name; }
+  /// channel 0: data port, 1: position port
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return channel == 0   ? wire::kVelodyneData
+           : channel == 1 ? wire::kVelodynePosition
+                          : std::string_view{};
+  }
   bool open(std::string& error) override;
   ReadStatus read(RawChunk& chunk, Duration timeout) override;
   void request_stop() override;

@@ -1,0 +1,109 @@
+#pragma once
+// Replays one stream of an MCAP recording through the Source interface (DESIGN.md, Data flow):
+// every raw channel whose posed.stream matches (raw_channels.hpp), merged in file order, each
+// read() returning the recorded bytes with the recorded log time as host_receive and the
+// recorded posed.source_channel as RawChunk::channel. Decoders, ClockSync and fusion downstream
+// cannot tell it from the device, and, being not live, the pipeline never drops its data:
+// the same file gives the same poses every time.
+//
+// A recording cut short replays up to the damage, then ends; the damage is logged once and kept
+// in damage().
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "drivers/common/source.hpp"
+#include "drivers/recording/mcap_reader.hpp"
+
+namespace posed::drivers::recording {
+
+struct McapReplayConfig {
+  /// the recording
+  std::string path;
+  /// posed.stream of the raw channels to replay ("imu", "lidar")
+  std::string stream;
+  /// Source name for logs and status; empty = `stream`
+  std::string name;
+  /// 1 = original timing, N = N times faster, 0 = as fast as read() is called (no sleeping)
+  double rate = 1.0;
+  /// skip this much log time from the stream's first message
+  Duration start_offset = Duration::from_ns(0);
+  /// replay this much log time after the start; 0 = to the end
+  Duration duration = Duration::from_ns(0);
+  /// start again at the end; host_receive keeps increasing (each pass is shifted by the span
+  /// replayed plus one inter-message gap) so clock sync downstream sees time move forward
+  bool loop = false;
+};
+
+/// One raw channel of the stream, as recorded.
+struct ReplayChannel {
+  std::uint32_t source_channel = 0;
+  std::string topic;
+  std::string wire_format;
+  /// everything in the Channel record's metadata (sensor config, calibration text)
+  std::map<std::string, std::string> metadata;
+};
+
+class McapReplaySource final : public Source {
+ public:
+  explicit McapReplaySource(McapReplayConfig config);
+
+  std::string_view name() const override { return name_; }
+  /// Opens the file; fails when it is not MCAP, or when its summary lists no raw channel of the
+  /// stream (the error names the streams it does hold).
+  bool open(std::string& error) override;
+  ReadStatus read(RawChunk& chunk, Duration timeout) override;
+  void request_stop() override;
+  SourceCounters counters() const override;
+  bool live() const override { return false; }
+  /// as recorded in the channel's posed.wire_format (known once the channel was seen)
+  std::string_view wire_format(std::uint32_t channel) const override;
+
+  /// The stream's channels seen so far (all of them after open() when the summary is intact).
+  std::vector<ReplayChannel> channels() const;
+  /// "" or where and why the recording ended early.
+  std::string damage() const;
+  /// completed passes over the recording (loop)
+  std::uint64_t passes() const { return passes_; }
+
+ private:
+  bool fetch();  // the next message of the stream into pending_, applying offset/duration/loop
+  bool wanted(const McapChannelRecord& c) const;
+  void note_damage();
+
+  McapReplayConfig config_;
+  std::string name_;
+  McapReader reader_;
+  bool opened_ = false;
+  bool ended_ = false;
+
+  bool have_pending_ = false;
+  McapMessage pending_;
+  std::int64_t pending_log_ns_ = 0;  // shifted by the loop offset
+
+  bool have_first_ = false;
+  std::int64_t first_log_ns_ = 0;  // the stream's first message in the file
+  std::int64_t last_log_ns_ = 0, prev_log_ns_ = 0;
+  std::int64_t loop_shift_ns_ = 0;
+  std::uint64_t passes_ = 0;
+  std::uint64_t delivered_this_pass_ = 0;
+
+  bool paced_ = false;
+  HostTime anchor_host_;
+  std::int64_t anchor_log_ns_ = 0;
+
+  std::atomic<bool> stop_{false};
+  std::mutex wait_mutex_;
+  std::condition_variable wait_cv_;
+  std::atomic<std::uint64_t> chunks_{0}, bytes_{0};
+  mutable std::mutex info_mutex_;
+  std::string damage_;
+  std::map<std::uint16_t, ReplayChannel> channels_;
+};
+
+}  // namespace posed::drivers::recording

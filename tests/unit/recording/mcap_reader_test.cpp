@@ -1,0 +1,341 @@
+// McapReader: round trips through the writer (none/lz4/zstd), files cut at many offsets (every
+// complete chunk is recovered and the reader says where it stopped), and bad input: wrong magic,
+// bad CRCs, unknown opcodes and compressions, channels without their schema.
+
+#include "drivers/recording/mcap_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "drivers/recording/crc32.hpp"
+#include "drivers/recording/mcap_format.hpp"
+#include "drivers/recording/mcap_writer.hpp"
+#include "tests/unit/recording/temp_dir.hpp"
+
+namespace posed::drivers::recording {
+namespace {
+
+std::vector<std::byte> payload_for(std::uint32_t i) {
+  // Varying lengths and contents, partly compressible.
+  std::vector<std::byte> p(20 + (i * 37) % 300);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    p[k] = static_cast<std::byte>(k % 7 == 0 ? (i * 13 + k) & 0xFF : 0x41);
+  }
+  return p;
+}
+
+struct Written {
+  std::vector<McapChunkInfo> chunks;
+  std::uint32_t messages = 0;
+};
+
+Written write_file(const std::string& path, McapCompression compression, std::uint32_t n,
+                   std::size_t chunk_size = 2048) {
+  McapWriterOptions opt;
+  opt.compression = compression;
+  opt.chunk_size_bytes = chunk_size;
+  opt.fsync_on_close = false;
+  McapWriter w;
+  std::string error;
+  EXPECT_TRUE(w.open(path, opt, error)) << error;
+  const std::string text = "int32 a\n";
+  const auto sid = w.add_schema("t/msg/A", "ros2msg",
+                                {reinterpret_cast<const std::byte*>(text.data()), text.size()});
+  const auto a = w.add_channel("/a", "cdr", sid, {{"posed.stream", "a"}});
+  const auto b = w.add_channel("/b", "posed-raw", 0, {});
+  for (std::uint32_t i = 0; i < n; ++i) {
+    EXPECT_TRUE(w.write_message(i % 3 == 0 ? b : a, i, 1'000'000 + i * 1000ull, i, payload_for(i)));
+  }
+  EXPECT_TRUE(w.close()) << w.error();
+  return {w.chunks(), n};
+}
+
+std::vector<std::uint32_t> read_sequences(McapReader& r) {
+  std::vector<std::uint32_t> seq;
+  McapMessage m;
+  while (r.next(m)) {
+    EXPECT_EQ(m.log_time_ns, 1'000'000 + m.sequence * 1000ull);
+    const auto want = payload_for(m.sequence);
+    EXPECT_TRUE(m.data.size() == want.size() &&
+                std::memcmp(m.data.data(), want.data(), want.size()) == 0)
+        << "payload of message " << m.sequence;
+    EXPECT_EQ(m.channel->topic, m.sequence % 3 == 0 ? "/b" : "/a");
+    seq.push_back(m.sequence);
+  }
+  return seq;
+}
+
+class RoundTrip : public ::testing::TestWithParam<McapCompression> {};
+
+TEST_P(RoundTrip, EveryMessageComesBackInOrder) {
+  test::TempDir dir("mcap_rt");
+  const auto w = write_file(dir.file("rt.mcap"), GetParam(), 500);
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open(dir.file("rt.mcap"), error)) << error;
+  EXPECT_TRUE(r.summary().usable());
+  EXPECT_EQ(r.summary().message_count, 500u);
+  EXPECT_EQ(r.summary().chunk_count, w.chunks.size());
+  EXPECT_EQ(r.channels().size(), 2u);
+  ASSERT_NE(r.schema(1), nullptr);
+  EXPECT_EQ(r.schema(1)->name, "t/msg/A");
+  const auto seq = read_sequences(r);
+  ASSERT_EQ(seq.size(), 500u);
+  for (std::uint32_t i = 0; i < 500; ++i) EXPECT_EQ(seq[i], i);
+  EXPECT_TRUE(r.complete()) << r.stop_reason();
+  EXPECT_TRUE(r.issues().empty()) << r.issues().front().what;
+  EXPECT_EQ(r.counters().chunks, w.chunks.size());
+  // rewind replays the same
+  r.rewind();
+  EXPECT_EQ(read_sequences(r).size(), 500u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Compression, RoundTrip,
+                         ::testing::Values(McapCompression::kNone, McapCompression::kLz4,
+                                           McapCompression::kZstd));
+
+TEST(Truncation, ACutFileYieldsEveryCompleteChunkAndSaysWhere) {
+  test::TempDir dir("mcap_cut");
+  const std::string full_path = dir.file("full.mcap");
+  const auto w = write_file(full_path, McapCompression::kLz4, 300, 1024);
+  ASSERT_GE(w.chunks.size(), 10u);
+  const auto full = test::slurp(full_path);
+  const std::size_t header_end = 8 + 9 + 4 + 4 + 5;  // magic + Header("", "posed")
+
+  // Every byte through the first two chunks, then a prime stride, then the tail byte by byte.
+  std::vector<std::size_t> cuts;
+  const std::size_t dense_end = static_cast<std::size_t>(w.chunks[1].index_end_offset) + 8;
+  for (std::size_t c = 0; c < dense_end; ++c) cuts.push_back(c);
+  for (std::size_t c = dense_end; c < full.size() - 200; c += 97) cuts.push_back(c);
+  for (std::size_t c = full.size() - 200; c < full.size(); ++c) cuts.push_back(c);
+
+  std::size_t data_end = static_cast<std::size_t>(w.chunks.back().index_end_offset);
+  for (std::size_t cut : cuts) {
+    const std::span<const std::byte> bytes(full.data(), cut);
+    McapReader r;
+    std::string error;
+    const bool opened = r.open_bytes(bytes, error);
+    if (cut < header_end) {
+      EXPECT_FALSE(opened) << "cut " << cut;
+      EXPECT_FALSE(error.empty());
+      continue;
+    }
+    ASSERT_TRUE(opened) << "cut " << cut << ": " << error;
+    // Expected: the messages of every chunk that ends at or before the cut.
+    std::uint64_t expected = 0;
+    for (const auto& c : w.chunks) {
+      if (c.start_offset + c.chunk_length <= cut) expected += c.message_count;
+    }
+    const auto seq = read_sequences(r);
+    ASSERT_EQ(seq.size(), expected) << "cut at " << cut;
+    for (std::size_t i = 0; i < seq.size(); ++i) ASSERT_EQ(seq[i], i);
+    if (cut <= data_end) {
+      EXPECT_FALSE(r.complete()) << "cut " << cut;
+      EXPECT_NE(r.stop_reason().find("offset"), std::string::npos) << r.stop_reason();
+      EXPECT_LE(r.offset(), cut);
+      EXPECT_FALSE(r.summary().usable());
+    } else {
+      // Cut inside the summary: the data is whole; the missing footer is reported.
+      EXPECT_EQ(seq.size(), 300u);
+      EXPECT_FALSE(r.summary().footer_found);
+      EXPECT_FALSE(r.issues().empty());
+    }
+  }
+}
+
+TEST(BadInput, WrongMagicIsRefusedWithTheOffset) {
+  std::vector<std::byte> junk(64, std::byte{0x42});
+  McapReader r;
+  std::string error;
+  EXPECT_FALSE(r.open_bytes(junk, error));
+  EXPECT_NE(error.find("magic"), std::string::npos) << error;
+  EXPECT_NE(error.find("offset 0"), std::string::npos) << error;
+  test::TempDir dir("mcap_missing");
+  EXPECT_FALSE(r.open(dir.file("nope.mcap"), error));
+  EXPECT_NE(error.find("nope.mcap"), std::string::npos) << error;
+}
+
+TEST(BadInput, AChunkWithABadCrcIsSkippedAndTheRestIsRead) {
+  test::TempDir dir("mcap_crc");
+  const auto w = write_file(dir.file("f.mcap"), McapCompression::kNone, 100, 1024);
+  auto bytes = test::slurp(dir.file("f.mcap"));
+  ASSERT_GE(w.chunks.size(), 3u);
+  const auto& victim = w.chunks[1];
+  // Flip a payload byte in the middle of chunk 1's records.
+  bytes[static_cast<std::size_t>(victim.start_offset + victim.chunk_length - 30)] ^= std::byte{1};
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open_bytes(bytes, error)) << error;
+  std::size_t n = 0;
+  McapMessage m;
+  while (r.next(m)) ++n;
+  EXPECT_EQ(n, 100 - victim.message_count);
+  EXPECT_EQ(r.counters().chunks_bad, 1u);
+  EXPECT_FALSE(r.complete());
+  bool named = false;
+  for (const auto& i : r.issues()) {
+    named = named || (i.offset == victim.start_offset && i.what.find("CRC") != std::string::npos);
+  }
+  EXPECT_TRUE(named) << "an issue naming the chunk's offset";
+  // The data-section CRC also notices.
+  bool data_crc = false;
+  for (const auto& i : r.issues())
+    data_crc = data_crc || i.what.find("data section") != i.what.npos;
+  EXPECT_TRUE(data_crc);
+}
+
+TEST(BadInput, ASummaryWithABadCrcFallsBackToTheScan) {
+  test::TempDir dir("mcap_sumcrc");
+  write_file(dir.file("f.mcap"), McapCompression::kLz4, 50);
+  auto bytes = test::slurp(dir.file("f.mcap"));
+  bytes[bytes.size() - 8 - 4] ^= std::byte{0xFF};  // the stored summary CRC
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open_bytes(bytes, error)) << error;
+  EXPECT_TRUE(r.summary().footer_found);
+  EXPECT_FALSE(r.summary().usable());
+  ASSERT_FALSE(r.issues().empty());
+  EXPECT_NE(r.issues().front().what.find("summary CRC"), std::string::npos);
+  EXPECT_EQ(read_sequences(r).size(), 50u);
+  EXPECT_TRUE(r.complete());
+}
+
+// Builds a file by hand: magic, Header, the given records, DataEnd (CRC 0), Footer(0,0,0), magic.
+std::vector<std::byte> handmade(const std::vector<std::byte>& middle) {
+  std::vector<std::byte> f;
+  mcap::Out o(f);
+  o.put(mcap::kMagic.data(), 8);
+  auto at = o.begin_record(mcap::Op::kHeader);
+  o.str("");
+  o.str("hand");
+  o.finish_record(at);
+  o.bytes(middle);
+  at = o.begin_record(mcap::Op::kDataEnd);
+  o.u32(0);
+  o.finish_record(at);
+  at = o.begin_record(mcap::Op::kFooter);
+  o.u64(0);
+  o.u64(0);
+  o.u32(0);
+  o.finish_record(at);
+  o.put(mcap::kMagic.data(), 8);
+  return f;
+}
+
+void channel(mcap::Out& o, std::uint16_t id, std::uint16_t schema, const char* topic) {
+  auto at = o.begin_record(mcap::Op::kChannel);
+  o.u16(id);
+  o.u16(schema);
+  o.str(topic);
+  o.str("posed-raw");
+  o.u32(0);
+  o.finish_record(at);
+}
+
+void message(mcap::Out& o, std::uint16_t ch, std::uint32_t seq, const char* text) {
+  auto at = o.begin_record(mcap::Op::kMessage);
+  o.u16(ch);
+  o.u32(seq);
+  o.u64(seq);
+  o.u64(seq);
+  o.put(text, std::strlen(text));
+  o.finish_record(at);
+}
+
+TEST(BadInput, UnknownOpcodesAreSkippedAsTheSpecSays) {
+  std::vector<std::byte> mid;
+  mcap::Out o(mid);
+  channel(o, 1, 0, "/x");
+  message(o, 1, 0, "first");
+  auto at = o.begin_record(static_cast<mcap::Op>(0x80));  // application extension
+  o.u64(123);
+  o.finish_record(at);
+  at = o.begin_record(static_cast<mcap::Op>(0x42));  // reserved, not yet defined
+  o.finish_record(at);
+  message(o, 1, 1, "second");
+  message(o, 7, 2, "orphan");  // channel 7 is never defined
+  const auto file = handmade(mid);
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open_bytes(file, error)) << error;
+  McapMessage m;
+  ASSERT_TRUE(r.next(m));
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(m.data.data()), m.data.size()), "first");
+  ASSERT_TRUE(r.next(m));
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(m.data.data()), m.data.size()), "second");
+  EXPECT_FALSE(r.next(m));
+  EXPECT_EQ(r.counters().unknown_records, 2u);
+  EXPECT_EQ(r.counters().orphan_messages, 1u);
+  EXPECT_TRUE(r.summary().footer_found);
+  EXPECT_FALSE(r.summary().present);
+}
+
+TEST(BadInput, AChannelWithoutItsSchemaIsReportedAndStillRead) {
+  std::vector<std::byte> mid;
+  mcap::Out o(mid);
+  channel(o, 3, 9, "/needs_schema_9");
+  message(o, 3, 0, "payload");
+  const auto file = handmade(mid);
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open_bytes(file, error)) << error;
+  McapMessage m;
+  ASSERT_TRUE(r.next(m));
+  EXPECT_EQ(m.channel->schema_id, 9);
+  EXPECT_EQ(r.schema(9), nullptr);
+  ASSERT_FALSE(r.issues().empty());
+  EXPECT_NE(r.issues().front().what.find("schema 9"), std::string::npos);
+  EXPECT_EQ(r.issues().front().offset, 8u + 9 + 4 + 4 + 4);  // the Channel record
+}
+
+TEST(BadInput, AChunkWithAnUnknownCompressionIsSkipped) {
+  std::vector<std::byte> mid;
+  mcap::Out o(mid);
+  channel(o, 1, 0, "/x");
+  const std::size_t chunk_at = mid.size();
+  auto at = o.begin_record(mcap::Op::kChunk);
+  o.u64(0);
+  o.u64(0);
+  o.u64(4);
+  o.u32(0);
+  o.str("brotli");
+  o.u64(4);
+  o.u32(0xDEADBEEF);
+  o.finish_record(at);
+  message(o, 1, 5, "after");
+  const auto file = handmade(mid);
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open_bytes(file, error)) << error;
+  McapMessage m;
+  ASSERT_TRUE(r.next(m));
+  EXPECT_EQ(m.sequence, 5u);
+  EXPECT_EQ(r.counters().chunks_bad, 1u);
+  ASSERT_FALSE(r.issues().empty());
+  EXPECT_NE(r.issues().front().what.find("brotli"), std::string::npos);
+  EXPECT_EQ(r.issues().front().offset, 8u + 9 + 4 + 4 + 4 + chunk_at);
+}
+
+TEST(BadInput, RecordLengthsBeyondTheFileStopCleanly) {
+  std::vector<std::byte> mid;
+  mcap::Out o(mid);
+  channel(o, 1, 0, "/x");
+  message(o, 1, 0, "ok");
+  o.u8(0x05);
+  o.u64(~0ull);  // absurd length
+  const auto file = handmade(mid);
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open_bytes(file, error)) << error;
+  McapMessage m;
+  ASSERT_TRUE(r.next(m));
+  EXPECT_FALSE(r.next(m));
+  EXPECT_FALSE(r.complete());
+  EXPECT_NE(r.stop_reason().find("truncated Message record"), std::string::npos) << r.stop_reason();
+}
+
+}  // namespace
+}  // namespace posed::drivers::recording
