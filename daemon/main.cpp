@@ -29,10 +29,36 @@ int main(int argc, char** argv) noexcept try {
   app.add_flag("--print-config", print_config,
                "print the effective configuration with units, ranges and descriptions, then exit");
   app.add_option("--duration", options.duration_s,
-                 "stop by itself after this long [s]; 0 runs until SIGTERM/SIGINT")
+                 "stop by itself after this long [s] (with --replay: replay this much of the "
+                 "recording); 0 runs until SIGTERM/SIGINT or the end of the recording")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--record", options.record_path,
+                 "record every sensor's raw bytes and the poses to this MCAP file");
+  auto* replay = app.add_option("--replay", options.replay.path,
+                                "replay this MCAP recording through the same pipeline instead of "
+                                "opening the sensors")
+                     ->check(CLI::ExistingFile);
+  bool max_speed = false;
+  app.add_option("--rate", options.replay.rate,
+                 "replay speed: 1 = recorded timing, N = N times faster")
+      ->check(CLI::PositiveNumber)
+      ->needs(replay);
+  app.add_flag("--max-speed", max_speed,
+               "replay as fast as the pipeline goes; lossless and deterministic")
+      ->needs(replay);
+  app.add_flag("--loop", options.replay.loop, "replay the recording again and again")
+      ->needs(replay);
+  app.add_option("--start", options.replay.start_s, "skip this much of the recording [s]")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(replay);
+  app.add_option("--wait-subscribers", options.wait_subscribers_s,
+                 "before publishing, wait up to this long for a reader of rt/posed/odom or "
+                 "rt/posed/pose to match [s]; default 1 with --replay, 0 live")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--version", version, "print the version and exit");
   CLI11_PARSE(app, argc, argv);
+  if (max_speed) options.replay.rate = 0;
+  options.replay.duration_s = options.duration_s;
 
   if (version) {
     std::printf("%.*s\n", static_cast<int>(posed::version_string().size()),

@@ -5,17 +5,24 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <map>
 #include <mutex>
 #include <optional>
+#include <sstream>
+#include <thread>
 
 #include "daemon/build_info.hpp"
+#include "daemon/config/config_loader.hpp"
 #include "daemon/dds/publisher.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
 #include "daemon/pipeline/pipeline.hpp"
+#include "daemon/pipeline/recording_tap.hpp"
 #include "daemon/pipeline/source_factory.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
+#include "drivers/recording/recorder.hpp"
 
 namespace posed {
 namespace {
@@ -43,7 +50,18 @@ struct PublishTally {
   std::optional<NavState> last;
   double distance_m = 0;
   HostTime next_pose_stamp;
+  /// the estimator publishes optimised states (so pose is not decimated from odom)
+  bool have_optimised = false;
 };
+
+/// A file's contents for the recording's metadata ("" when unset or unreadable).
+std::string read_text_file(const std::string& path) {
+  if (path.empty()) return {};
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 }  // namespace
 
@@ -57,7 +75,8 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   const HostTime started = drivers::host_now();
-  const HostToWall to_wall{drivers::wall_now() - WallTime::from_ns(started.ns)};
+  HostToWall to_wall{drivers::wall_now() - WallTime::from_ns(started.ns)};
+  const bool replaying = !options.replay.path.empty();
 
   dds::DdsConfig dds_config;
   dds_config.domain_id = static_cast<std::uint32_t>(config.dds.domain_id);
@@ -71,7 +90,18 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     return 1;
   }
 
-  pipeline::BuiltSources built = pipeline::make_sources(config, error);
+  pipeline::BuiltSources built;
+  std::string replay_streams;
+  if (replaying) {
+    pipeline::ReplaySources replay = pipeline::make_replay_sources(options.replay, error);
+    // Replayed stamps are the recording's host clock; its wall offset keeps the DDS stamps (and
+    // so the ground truth of a simulated run) in the recorded time base.
+    if (replay.have_host_to_wall) to_wall = replay.host_to_wall;
+    built = std::move(replay.built);
+    replay_streams = replay.streams;
+  } else {
+    built = pipeline::make_sources(config, error);
+  }
   if (!built.sources.imu) {
     POSED_LOG_ERROR("%s", error.c_str());
     return 1;
@@ -79,30 +109,65 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   // Owned by the pipeline, which outlives every use below.
   const drivers::SyntheticImuSource* synthetic = built.synthetic;
 
+  std::unique_ptr<drivers::recording::Recorder> recorder;
+  if (!options.record_path.empty()) {
+    recorder = std::make_unique<drivers::recording::Recorder>();
+    // Every channel carries the effective configuration: a recording says how it was made.
+    const std::string effective_config = config::print_config(config);
+    drivers::recording::RecorderOptions recorder_options;
+    recorder_options.host_to_wall = to_wall;
+    if (!recorder->open(options.record_path, recorder_options, error)) {
+      POSED_LOG_ERROR("cannot record: %s", error.c_str());
+      return 1;
+    }
+    built.sources.imu = std::make_unique<pipeline::RecordingTap>(
+        std::move(built.sources.imu), *recorder,
+        std::map<std::string, std::string>{{"posed.imu.source", config.imu.source},
+                                           {"posed.imu.device", config.imu.serial_device},
+                                           {"posed.config", effective_config}});
+    if (built.sources.lidar) {
+      built.sources.lidar = std::make_unique<pipeline::RecordingTap>(
+          std::move(built.sources.lidar), *recorder,
+          std::map<std::string, std::string>{
+              {"posed.lidar.address", config.lidar.address},
+              {"posed.lidar.calibration", config.lidar.calibration},
+              {"posed.lidar.calibration_text", read_text_file(config.lidar.calibration)},
+              {"posed.config", effective_config}});
+    }
+    POSED_LOG_INFO("recording raw streams and poses to %s", options.record_path.c_str());
+  }
+
   PublishTally tally;
   const Duration pose_period = Duration::from_seconds(1.0 / config.publish.pose_rate_hz);
   std::uint64_t state_index = 0;
   pipeline::PipelineOutputs outputs;
   outputs.on_state = [&](const NavState& s) {
-    if (tally.last) tally.distance_m += (s.p_map_base_m - tally.last->p_map_base_m).norm();
-    if (!tally.first) tally.first = s;
-    tally.last = s;
     const WallTime stamp = to_wall(s.stamp);
-    if (state_index++ % static_cast<std::uint64_t>(config.publish.odom_decimation) == 0) {
-      dds::OdomMessage odom;
-      odom.stamp = stamp;
-      odom.p_map_base_m = s.p_map_base_m;
-      odom.q_map_base = s.q_map_base;
-      odom.v_base_mps = s.q_map_base.conjugate() * s.v_map_mps;
-      odom.w_base_radps = s.w_base_radps;
-      odom.pose_covariance = to_row_major(s.pose_covariance);
-      odom.twist_covariance = to_row_major(s.twist_covariance);
-      if (publisher->publish_odom(odom))
-        ++tally.odom;
-      else
-        ++tally.failed;
+    // Optimised states (one per scan) go on rt/posed/pose; IMU propagation on rt/posed/odom. An
+    // estimator without optimised states (strapdown) has its propagation decimated onto pose.
+    if (s.optimised) tally.have_optimised = true;
+    if (!s.optimised) {
+      if (tally.last) tally.distance_m += (s.p_map_base_m - tally.last->p_map_base_m).norm();
+      if (!tally.first) tally.first = s;
+      tally.last = s;
+      if (state_index++ % static_cast<std::uint64_t>(config.publish.odom_decimation) == 0) {
+        dds::OdomMessage odom;
+        odom.stamp = stamp;
+        odom.p_map_base_m = s.p_map_base_m;
+        odom.q_map_base = s.q_map_base;
+        odom.v_base_mps = s.q_map_base.conjugate() * s.v_map_mps;
+        odom.w_base_radps = s.w_base_radps;
+        odom.pose_covariance = to_row_major(s.pose_covariance);
+        odom.twist_covariance = to_row_major(s.twist_covariance);
+        if (publisher->publish_odom(odom))
+          ++tally.odom;
+        else
+          ++tally.failed;
+      }
     }
-    if (s.stamp >= tally.next_pose_stamp) {
+    const bool pose_now =
+        s.optimised || (!tally.have_optimised && s.stamp >= tally.next_pose_stamp);
+    if (pose_now) {
       tally.next_pose_stamp = s.stamp + pose_period;
       dds::PoseMessage pose;
       pose.stamp = stamp;
@@ -112,6 +177,12 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
         ++tally.pose;
       else
         ++tally.failed;
+      if (recorder) {
+        const Eigen::Quaterniond& q = s.q_map_base;
+        recorder->write_pose("/posed/pose", stamp, config.dds.map_frame,
+                             {s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z()},
+                             {q.x(), q.y(), q.z(), q.w()});
+      }
     }
   };
   std::mutex status_line_mutex;
@@ -121,6 +192,11 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     msg.stamp = to_wall(st.stamp);
     msg.version = std::string(version_string());
     msg.estimator_mode = std::string(to_string(st.mode));
+    const FusionFigures& f = st.estimator;
+    msg.estimator = {
+        f.scans_used,        f.scans_rejected, f.scans_degenerate,      f.scans_skipped,
+        f.reinitialisations, f.keyframes,      f.degenerate_directions, f.gyro_bias_radps,
+        f.accel_bias_mps2};
     msg.uptime_s = (st.stamp - started).seconds();
     std::string line = std::string(to_string(st.mode));
     for (const auto& s : st.streams) {
@@ -156,7 +232,23 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     status_line = line;
   };
 
+  const bool built_has_lidar = built.sources.lidar != nullptr;
+  // A replay at full speed can be over before discovery has matched a reader that was already
+  // waiting for it (volatile durability: samples before the match are not delivered). Give such
+  // readers a moment to match first; live data has no beginning worth waiting for.
+  const double wait_s = options.wait_subscribers_s >= 0 ? options.wait_subscribers_s
+                        : replaying                     ? 1.0
+                                                        : 0.0;
+  if (wait_s > 0) {
+    const HostTime give_up = drivers::host_now() + Duration::from_seconds(wait_s);
+    while (publisher->matched_subscribers(dds::Topic::kOdom) == 0 &&
+           publisher->matched_subscribers(dds::Topic::kPose) == 0 &&
+           drivers::host_now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
   pipeline::Pipeline pipe(config, std::move(built.sources), std::move(outputs));
+  const HostTime pipeline_started = drivers::host_now();
   if (!pipe.start(error)) {
     POSED_LOG_ERROR("cannot start the pipeline: %s", error.c_str());
     return 1;
@@ -165,17 +257,22 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   notify::SdNotifier notifier;
   notify::StageWatchdog watchdog;
   // Only the stages this pipeline runs are watched; a stage that never started cannot stall.
-  std::vector<std::pair<pipeline::Stage, notify::StageWatchdog::StageId>> watched;
-  for (const pipeline::Stage stage : pipe.active_stages()) {
-    watched.emplace_back(
-        stage,
-        watchdog.register_stage(std::string(pipeline::kStageNames[static_cast<std::size_t>(stage)]),
-                                Duration::from_seconds(config.watchdog.stage_deadline_s), started));
+  std::vector<notify::StageWatchdog::StageId> watched;
+  for (const std::string& stage : pipe.stage_names()) {
+    watched.push_back(watchdog.register_stage(
+        stage, Duration::from_seconds(config.watchdog.stage_deadline_s), started));
   }
   notify::WatchdogPinger pinger(notifier.watchdog_interval());
   notifier.notify("READY=1\nSTATUS=sources open, aligning");
-  POSED_LOG_INFO("running: %s on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
-                 config.imu.source.c_str(), config.dds.domain_id);
+  if (replaying) {
+    POSED_LOG_INFO(
+        "replaying %s (%s) on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
+        options.replay.path.c_str(), replay_streams.c_str(), config.dds.domain_id);
+  } else {
+    POSED_LOG_INFO(
+        "running: imu %s%s on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
+        config.imu.source.c_str(), config.lidar.enabled ? ", lidar" : "", config.dds.domain_id);
+  }
 
   int exit_code = 0;
   bool stopping = false;
@@ -197,15 +294,16 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     } else if (sig == SIGHUP) {
       POSED_LOG_NOTICE("SIGHUP: no setting can be reloaded while running yet; restart to apply");
     }
-    if (!stopping && options.duration_s > 0 && (now - started).seconds() >= options.duration_s) {
+    if (!stopping && !replaying && options.duration_s > 0 &&
+        (now - started).seconds() >= options.duration_s) {
       POSED_LOG_INFO("--duration %.1f s reached: draining and stopping", options.duration_s);
       notifier.notify("STOPPING=1\nSTATUS=draining");
       stopping = true;
       pipe.request_stop();
     }
-    const auto beats = pipe.stage_heartbeats();
-    for (const auto& [stage, id] : watched) {
-      watchdog.heartbeat(id, beats[static_cast<std::size_t>(stage)]);
+    const std::vector<pipeline::StageBeat> beats = pipe.stage_heartbeats();
+    for (std::size_t i = 0; i < watched.size() && i < beats.size(); ++i) {
+      watchdog.heartbeat(watched[i], beats[i].last);
     }
     std::string line;
     {
@@ -220,13 +318,17 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     }
   }
   pipe.join();
+  if (recorder && !recorder->close()) {
+    POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());
+    exit_code = 1;
+  }
 
   // The summary a person reads at the end of a run.
   const pipeline::PipelineStatus st = pipe.status();
   const double run_s = (drivers::host_now() - started).seconds();
   std::printf("\nposed summary\n");
   std::printf("  run time            %.1f s\n", run_s);
-  std::printf("  estimator           %s (IMU-only dead reckoning: drifts without aiding)\n",
+  std::printf("  estimator           %s, last mode %s\n", pipe.estimator_description().c_str(),
               std::string(to_string(st.mode)).c_str());
   for (const auto& s : st.streams) {
     std::printf(
@@ -237,20 +339,54 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
         static_cast<unsigned long long>(s.malformed), static_cast<unsigned long long>(s.dropped),
         s.clock_state.c_str(), static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
   }
-  if (config.lidar.enabled) {
+  if (replaying) {
+    std::printf("  replayed            %s (%s)\n", options.replay.path.c_str(),
+                replay_streams.c_str());
+    // What a replay costs: the span of data turned into poses per second of wall time.
+    const double processing_s = (drivers::host_now() - pipeline_started).seconds();
+    if (tally.first && tally.last && processing_s > 0) {
+      const double span_s = (tally.last->stamp - tally.first->stamp).seconds();
+      std::printf("  real-time factor    %.2fx (%.1f s of data in %.1f s)\n", span_s / processing_s,
+                  span_s, processing_s);
+    }
+  }
+  if (built_has_lidar) {
     std::printf(
         "  lidar scans         %llu assembled (%.0f points/scan mean), %llu reached the "
-        "fusion core (not used by the strapdown estimator)\n",
+        "fusion core, %llu used by the estimator\n",
         static_cast<unsigned long long>(st.lidar_scans),
         st.lidar_scans ? static_cast<double>(st.lidar_points) / static_cast<double>(st.lidar_scans)
                        : 0.0,
-        static_cast<unsigned long long>(st.lidar_scans_fused));
+        static_cast<unsigned long long>(st.lidar_scans_fused),
+        static_cast<unsigned long long>(st.estimator.scans_used));
+  }
+  if (built_has_lidar) {
+    const FusionFigures& f = st.estimator;
+    std::printf(
+        "  scan matching       %llu used, %llu rejected, %llu degenerate, %llu skipped; %llu "
+        "keyframes; %llu re-initialisations\n",
+        static_cast<unsigned long long>(f.scans_used),
+        static_cast<unsigned long long>(f.scans_rejected),
+        static_cast<unsigned long long>(f.scans_degenerate),
+        static_cast<unsigned long long>(f.scans_skipped),
+        static_cast<unsigned long long>(f.keyframes),
+        static_cast<unsigned long long>(f.reinitialisations));
+    std::printf("  IMU biases          gyro [%.5f %.5f %.5f] rad/s, accel [%.4f %.4f %.4f] m/s^2\n",
+                f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
+                f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());
   }
   std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
               static_cast<unsigned long long>(tally.odom),
               static_cast<unsigned long long>(tally.pose),
               static_cast<unsigned long long>(tally.status), config.dds.domain_id,
               tally.failed ? " (some writes failed)" : "");
+  if (recorder) {
+    const auto rc = recorder->counters();
+    std::printf("  recorded            %llu messages to %s (%.1f MB, %llu dropped)\n",
+                static_cast<unsigned long long>(rc.messages_written), options.record_path.c_str(),
+                static_cast<double>(rc.bytes_on_disk) / 1e6,
+                static_cast<unsigned long long>(rc.dropped));
+  }
   if (tally.last) {
     const NavState& s = *tally.last;
     std::printf("  final pose          x %.3f m, y %.3f m, z %.3f m, yaw %.1f deg\n",

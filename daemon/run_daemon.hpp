@@ -5,13 +5,22 @@
 #include <string>
 
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/replay_sources.hpp"
 
 namespace posed {
 
 struct RunOptions {
   std::string config_path = "/etc/posed/posed.yaml";
-  /// stop by itself after this long; 0 = until a signal [s]
+  /// stop by itself after this long; 0 = until a signal [s] (live Sources only; a replay's
+  /// span is replay.duration_s)
   double duration_s = 0;
+  /// record every Source's raw bytes, and the poses, to this MCAP file; empty = no recording
+  std::string record_path;
+  /// replay this recording instead of opening the sensors (replay.path empty = live)
+  pipeline::ReplayOptions replay;
+  /// before the first sample, wait up to this long for a DDS reader of odom or pose to match;
+  /// negative: 1 s when replaying (a fast replay could end before discovery), 0 live [s]
+  double wait_subscribers_s = -1;
 };
 
 /// Returns the process exit code.

@@ -61,6 +61,18 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
   out.header.stamp = to_ros_time(msg.stamp);
   out.version = c_str(msg.version);
   out.estimator_mode = c_str(msg.estimator_mode);
+  const EstimatorStatusMessage& e = msg.estimator;
+  out.estimator.scans_used = e.scans_used;
+  out.estimator.scans_rejected = e.scans_rejected;
+  out.estimator.scans_degenerate = e.scans_degenerate;
+  out.estimator.scans_skipped = e.scans_skipped;
+  out.estimator.reinitialisations = e.reinitialisations;
+  out.estimator.keyframes = e.keyframes;
+  out.estimator.degenerate_directions = e.degenerate_directions;
+  for (int i = 0; i < 3; ++i) {
+    out.estimator.gyro_bias_radps[i] = e.gyro_bias_radps[i];
+    out.estimator.accel_bias_mps2[i] = e.accel_bias_mps2[i];
+  }
   out.uptime_s = msg.uptime_s;
   out.summary = c_str(msg.summary);
   if (streams.size() < msg.streams.size()) streams.resize(msg.streams.size());
@@ -113,6 +125,18 @@ StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
   msg.stamp = from_ros_time(in.header.stamp);
   msg.version = to_string(in.version);
   msg.estimator_mode = to_string(in.estimator_mode);
+  EstimatorStatusMessage& e = msg.estimator;
+  e.scans_used = in.estimator.scans_used;
+  e.scans_rejected = in.estimator.scans_rejected;
+  e.scans_degenerate = in.estimator.scans_degenerate;
+  e.scans_skipped = in.estimator.scans_skipped;
+  e.reinitialisations = in.estimator.reinitialisations;
+  e.keyframes = in.estimator.keyframes;
+  e.degenerate_directions = in.estimator.degenerate_directions;
+  for (int i = 0; i < 3; ++i) {
+    e.gyro_bias_radps[i] = in.estimator.gyro_bias_radps[i];
+    e.accel_bias_mps2[i] = in.estimator.accel_bias_mps2[i];
+  }
   msg.uptime_s = in.uptime_s;
   msg.summary = to_string(in.summary);
   msg.streams.reserve(in.streams._length);

@@ -106,14 +106,28 @@ struct StreamStatusMessage {
   std::string health;
 };
 
+/// posed_msgs/EstimatorStatus: the estimator's figures.
+struct EstimatorStatusMessage {
+  std::uint64_t scans_used = 0;                               ///< [count]
+  std::uint64_t scans_rejected = 0;                           ///< [count]
+  std::uint64_t scans_degenerate = 0;                         ///< [count]
+  std::uint64_t scans_skipped = 0;                            ///< [count]
+  std::uint64_t reinitialisations = 0;                        ///< [count]
+  std::uint64_t keyframes = 0;                                ///< [count]
+  std::int32_t degenerate_directions = 0;                     ///< in the last scan match [count]
+  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  ///< [rad/s]
+  Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< [m/s^2]
+};
+
 /// posed_msgs/Status: published at 1 Hz.
 struct StatusMessage {
   /// time of the report (wall clock, UNIX epoch) [ns]
   WallTime stamp;
   /// daemon version, e.g. "posed 0.1.0"
   std::string version;
-  /// estimator mode, e.g. "strapdown"
+  /// estimator mode, e.g. "strapdown", "lidar_inertial"
   std::string estimator_mode;
+  EstimatorStatusMessage estimator;
   /// time since the daemon started [s]
   double uptime_s = 0.0;
   /// one-line human-readable summary

@@ -1,13 +1,16 @@
 #pragma once
 // The pipeline: Sources -> decoders -> clock sync -> queues -> fusion core -> outputs, one thread
 // per stage (DESIGN.md, Data flow). The daemon and `posectl replay` build it with the same code;
-// they differ only in the Sources passed in.
+// they differ only in the Sources passed in. Each stage lives in its own file:
+//   imu_stage      Source -> A9 decoder -> ClockSync -> IMU queue
+//   lidar_stage    Source -> Velodyne decoder -> ClockSync -> scan assembler -> scan queue
+//   fusion_stage   merge of the measurement queues -> FusionCore -> state queue
+//   publisher_stage  states -> on_state, status snapshots -> on_status
 //
 // Stop protocol: request_stop() stops the Sources; each stage forwards end-of-stream through its
 // queue after what it already holds, so everything measured is processed and published (drain).
 // The daemon aborts on a second signal instead of waiting.
 
-#include <array>
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -16,47 +19,28 @@
 #include <vector>
 
 #include "core/estimator/nav_state.hpp"
-#include "core/measurements.hpp"
 #include "core/spsc_queue.hpp"
 #include "core/time.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/pipeline_status.hpp"
+#include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 #include "drivers/common/source.hpp"
 
 namespace posed::pipeline {
 
+class ImuStage;
+class LidarStage;
+class FusionStage;
+class PublisherStage;
+struct LidarScanCounters;
+struct FusionCounters;
+
 struct PipelineSources {
-  /// bytes in the A9 wire format (live serial, synthetic, or replayed)
+  /// IMU bytes (live serial, synthetic, or replayed); required
   std::unique_ptr<drivers::Source> imu;
   /// VLP-32C UDP payloads, channel 0 data, 1 position (live UDP, pcap, or replayed); optional
   std::unique_ptr<drivers::Source> lidar;
-};
-
-/// Per-stream figures for rt/posed/status and the exit summary.
-struct StreamStatus {
-  std::string name;
-  double rate_hz = 0;           ///< decoded per second between status messages (publisher only)
-  std::uint64_t received = 0;   ///< chunks read from the Source
-  std::uint64_t decoded = 0;    ///< measurements decoded
-  std::uint64_t dropped = 0;    ///< measurements dropped by the queue policy
-  std::uint64_t malformed = 0;  ///< frames rejected by the decoder (CRC, truncation, unknown)
-  std::int64_t clock_offset_ns = 0;  ///< host minus device time [ns]
-  double clock_drift_ppm = 0;        ///< device clock rate error [ppm]
-  double clock_jitter_ns = 0;        ///< spread of arrival delays [ns]
-  double clock_uncertainty_ns = 0;   ///< 1-sigma of the mapped stamps [ns]
-  std::string clock_state;           ///< converging | locked | lost
-  std::string health;                ///< ok | no_data | degraded, with a reason
-};
-
-struct PipelineStatus {
-  HostTime stamp;
-  EstimatorMode mode = EstimatorMode::kAligning;
-  std::vector<StreamStatus> streams;
-  std::uint64_t lidar_scans = 0;        ///< scans assembled
-  std::uint64_t lidar_points = 0;       ///< points in those scans
-  std::uint64_t lidar_scans_fused = 0;  ///< scans the fusion core received
-  std::uint64_t states = 0;             ///< states produced by the fusion core
-  std::uint64_t states_dropped = 0;     ///< states dropped between fusion and publisher
 };
 
 /// Callbacks run on the publisher thread.
@@ -67,9 +51,11 @@ struct PipelineOutputs {
   std::function<void(const PipelineStatus&)> on_status;
 };
 
-enum class Stage : std::uint8_t { kImuSource, kLidarSource, kFusion, kPublisher };
-inline constexpr std::array<std::string_view, 4> kStageNames = {"imu_source", "lidar_source",
-                                                                "fusion", "publisher"};
+/// One stage's last sign of life, for the systemd watchdog.
+struct StageBeat {
+  std::string name;  ///< "imu_source", "lidar_source", "fusion", "publisher"
+  HostTime last;
+};
 
 class Pipeline {
  public:
@@ -84,49 +70,44 @@ class Pipeline {
   /// Drain: Sources stop, queued data flows through, threads end. Safe from any thread.
   void request_stop();
   /// True once every stage thread has finished.
-  bool finished() const { return finished_stages_.load() == active_stages().size(); }
+  bool finished() const { return started_ && finished_stages_.load() == heartbeats_.size(); }
   /// The stages this pipeline runs (the lidar stage only with a lidar Source).
-  std::vector<Stage> active_stages() const;
+  std::vector<std::string> stage_names() const;
   /// Joins the threads (call after finished() or request_stop()).
   void join();
 
-  /// Last activity of each stage on the host clock, for the systemd watchdog.
-  std::array<HostTime, kStageNames.size()> stage_heartbeats() const;
+  /// Last activity of each stage on the host clock, in stage_names() order.
+  std::vector<StageBeat> stage_heartbeats() const;
   /// A snapshot, safe from any thread.
   PipelineStatus status() const;
+  /// The fusion core's one-line description (valid after start()).
+  std::string estimator_description() const;
 
  private:
-  struct ImuItem {
-    ImuSample sample;
-    bool end_of_stream = false;
-  };
-  struct ScanItem {
-    LidarScan scan;
-    bool end_of_stream = false;
-  };
-  struct StateItem {
-    NavState state;
-    bool end_of_stream = false;
-  };
-  struct Impl;
-
-  void run_imu_source();
-  void run_lidar_source();
-  void run_fusion();
-  void run_publisher();
-  void beat(Stage stage);
+  Heartbeat& add_stage(std::string name);
+  void launch(std::function<void()> body);
 
   config::PosedConfig config_;
   PipelineSources sources_;
   PipelineOutputs outputs_;
   SpscQueue<ImuItem> imu_queue_;
-  SpscQueue<ScanItem> scan_queue_;
+  std::unique_ptr<SpscQueue<ScanItem>> scan_queue_;
   SpscQueue<StateItem> state_queue_;
-  /// signalled by both source stages: the fusion core has input
+  /// signalled by every source stage: the fusion stage has input
   Wakeup fusion_ready_;
   Wakeup state_ready_;
-  std::unique_ptr<Impl> impl_;
-  std::array<std::atomic<std::int64_t>, kStageNames.size()> heartbeat_ns_{};
+
+  StreamCounters imu_counters_;
+  StreamCounters lidar_counters_;
+  std::unique_ptr<LidarScanCounters> scan_counters_;
+  std::unique_ptr<FusionCounters> fusion_counters_;
+  std::vector<std::unique_ptr<Heartbeat>> heartbeats_;
+
+  std::unique_ptr<ImuStage> imu_stage_;
+  std::unique_ptr<LidarStage> lidar_stage_;
+  std::unique_ptr<FusionStage> fusion_stage_;
+  std::unique_ptr<PublisherStage> publisher_stage_;
+  bool started_ = false;
   std::atomic<std::size_t> finished_stages_{0};
   std::vector<std::thread> threads_;
 };

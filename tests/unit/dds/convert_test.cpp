@@ -78,7 +78,13 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   StatusMessage msg;
   msg.stamp = WallTime::from_ns(9'000'000'000);
   msg.version = "posed 0.1.0";
-  msg.estimator_mode = "strapdown";
+  msg.estimator_mode = "degenerate";
+  msg.estimator.scans_used = 1234;
+  msg.estimator.scans_degenerate = 56;
+  msg.estimator.reinitialisations = 2;
+  msg.estimator.degenerate_directions = 1;
+  msg.estimator.gyro_bias_radps = {0.001, -0.002, 0.003};
+  msg.estimator.accel_bias_mps2 = {0.04, -0.05, 0.06};
   msg.uptime_s = 12.5;
   msg.summary = "ok";
   for (const char* name : {"imu", "lidar", "color"}) {
@@ -110,6 +116,12 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   EXPECT_EQ(back.stamp, msg.stamp);
   EXPECT_EQ(back.version, msg.version);
   EXPECT_EQ(back.estimator_mode, msg.estimator_mode);
+  EXPECT_EQ(back.estimator.scans_used, 1234u);
+  EXPECT_EQ(back.estimator.scans_degenerate, 56u);
+  EXPECT_EQ(back.estimator.reinitialisations, 2u);
+  EXPECT_EQ(back.estimator.degenerate_directions, 1);
+  EXPECT_EQ(back.estimator.gyro_bias_radps, msg.estimator.gyro_bias_radps);
+  EXPECT_EQ(back.estimator.accel_bias_mps2, msg.estimator.accel_bias_mps2);
   EXPECT_EQ(back.uptime_s, msg.uptime_s);
   EXPECT_EQ(back.summary, msg.summary);
   ASSERT_EQ(back.streams.size(), 3u);

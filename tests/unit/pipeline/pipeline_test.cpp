@@ -51,6 +51,9 @@ class CorruptingSource final : public drivers::Source {
   void request_stop() override { inner_->request_stop(); }
   drivers::SourceCounters counters() const override { return inner_->counters(); }
   bool live() const override { return inner_->live(); }
+  std::string_view wire_format(std::uint32_t channel) const override {
+    return inner_->wire_format(channel);
+  }
 
  private:
   std::unique_ptr<drivers::Source> inner_;

@@ -1,0 +1,64 @@
+#include "daemon/pipeline/estimator_config.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace posed::pipeline {
+
+Eigen::Isometry3d to_isometry(const config::Transform4& T) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int col = 0; col < 3; ++col)
+      out.linear()(r, col) = T[static_cast<std::size_t>(4 * r + col)];
+    out.translation()[r] = T[static_cast<std::size_t>(4 * r + 3)];
+  }
+  return out;
+}
+
+estimator::LioConfig lio_config(const config::PosedConfig& c) {
+  constexpr double kDeg = M_PI / 180.0;
+  estimator::LioConfig l;
+  l.gravity_mps2 = c.imu.gravity_mps2;
+  l.noise = {.gyro_noise_density = c.imu.gyro_noise_density,
+             .accel_noise_density = c.imu.accel_noise_density,
+             .gyro_random_walk = c.imu.gyro_random_walk,
+             .accel_random_walk = c.imu.accel_random_walk};
+  l.alignment = {.gravity_mps2 = c.imu.gravity_mps2,
+                 .window = Duration::from_seconds(c.estimator.init_static_s),
+                 .max_gyro_radps = c.estimator.init_max_gyro_radps,
+                 .gyro_noise_density = c.imu.gyro_noise_density,
+                 .accel_noise_density = c.imu.accel_noise_density};
+  l.T_imu_lidar = to_isometry(c.extrinsics.T_imu_lidar);
+  const auto& e = c.estimator;
+  l.lidar.min_range_m = static_cast<float>(std::max(c.lidar.min_range_m, 1.0));
+  l.lidar.max_range_m = static_cast<float>(c.lidar.max_range_m);
+  l.lidar.features.columns = static_cast<int>(std::lround(60.0 / c.lidar.rpm / 55.296e-6));
+  l.lidar.features.plane_voxel_m = e.plane_voxel_m;
+  l.lidar.features.edge_voxel_m = e.edge_voxel_m;
+  l.lidar.matcher.handle_degeneracy = e.degeneracy_handling;
+  l.lidar.matcher.degeneracy_translation_threshold = e.degeneracy_translation_threshold;
+  l.lidar.matcher.degeneracy_rotation_threshold_m2 = e.degeneracy_rotation_threshold_m2;
+  l.lidar.map_radius_m = e.map_radius_m;
+  l.lidar.keyframe_distance_m = e.keyframe_distance_m;
+  l.lidar.keyframe_angle_rad = e.keyframe_angle_deg * kDeg;
+  l.window.size = e.window_size;
+  l.window.max_iterations = e.solver_iterations;
+  l.max_speed_mps = e.max_speed_mps;
+  l.max_gyro_bias_radps = e.max_gyro_bias_radps;
+  l.max_accel_bias_mps2 = e.max_accel_bias_mps2;
+  l.max_match_jump_m = e.max_match_jump_m;
+  l.max_match_jump_rad = e.max_match_jump_deg * kDeg;
+  return l;
+}
+
+StrapdownConfig strapdown_config(const config::PosedConfig& c) {
+  return StrapdownConfig{
+      .gravity_mps2 = c.imu.gravity_mps2,
+      .init_static = Duration::from_seconds(c.estimator.init_static_s),
+      .init_max_gyro_radps = c.estimator.init_max_gyro_radps,
+      .gyro_noise_density = c.imu.gyro_noise_density,
+      .accel_noise_density = c.imu.accel_noise_density,
+  };
+}
+
+}  // namespace posed::pipeline

@@ -1,0 +1,17 @@
+#pragma once
+// The estimators' plain-struct configuration from a PosedConfig (core/ never sees YAML): used by
+// the pipeline, `posectl bench lio` and the tests, so all three run the same estimator.
+
+#include "core/estimator/lio_estimator.hpp"
+#include "core/estimator/strapdown.hpp"
+#include "daemon/config/posed_config.hpp"
+
+namespace posed::pipeline {
+
+estimator::LioConfig lio_config(const config::PosedConfig& config);
+StrapdownConfig strapdown_config(const config::PosedConfig& config);
+
+/// A 4x4 row-major config transform as an isometry.
+Eigen::Isometry3d to_isometry(const config::Transform4& T);
+
+}  // namespace posed::pipeline

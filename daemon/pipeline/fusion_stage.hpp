@@ -1,0 +1,80 @@
+#pragma once
+// The fusion stage (one thread): merges the measurement queues and drives the FusionCore
+// (core/estimator/fusion_core.hpp), whose states go to the publisher's queue.
+//
+// Order. Each queue delivers its stream in stamp order (IMU sample stamp, scan end stamp). With
+// recordings as Sources (`in_stamp_order`), the stage merges the streams by stamp: it hands the
+// core the oldest head only once every stream that has not ended has a head to compare with —
+// a k-way merge that waits for the slowest stream. The core then sees one order, a function of
+// the data alone, however the threads were scheduled: max-speed replays are deterministic. Live,
+// waiting for the slowest sensor would add its period to every pose's latency, so the stage hands
+// over whatever has arrived, oldest first, and the core's MeasurementGate orders the rest.
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "core/estimator/fusion_core.hpp"
+#include "core/spsc_queue.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/stage_support.hpp"
+#include "daemon/pipeline/wakeup.hpp"
+
+namespace posed::pipeline {
+
+/// Figures the status snapshot reads from other threads.
+struct FusionCounters {
+  std::atomic<std::uint64_t> states{0};       ///< states the core produced
+  std::atomic<std::uint64_t> scans_fused{0};  ///< scans handed to the core
+  std::atomic<EstimatorMode> mode{EstimatorMode::kAligning};
+
+  void publish_figures(const FusionFigures& f) {
+    std::lock_guard lock(mutex_);
+    figures_ = f;
+  }
+  FusionFigures figures() const {
+    std::lock_guard lock(mutex_);
+    return figures_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  FusionFigures figures_;
+};
+
+struct FusionInputs {
+  SpscQueue<ImuItem>* imu = nullptr;     ///< required
+  SpscQueue<ScanItem>* scans = nullptr;  ///< null without a lidar
+};
+
+class FusionStage {
+ public:
+  FusionStage(const config::PosedConfig& config, std::unique_ptr<FusionCore> core,
+              FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
+              Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
+              FusionCounters& counters);
+  /// Runs until every input stream has ended, then forwards end-of-stream to the publisher.
+  void run();
+  const FusionCore& core() const { return *core_; }
+
+ private:
+  template <class Item>
+  class Lane;
+  /// Hands the core every measurement the merge rule releases now; true if it handed any.
+  bool dispatch_ready();
+  void emit_states();
+
+  const config::PosedConfig& config_;
+  std::unique_ptr<FusionCore> core_;
+  FusionInputs inputs_;
+  bool in_stamp_order_;
+  SpscQueue<StateItem>& states_;
+  Wakeup& inputs_ready_;
+  Wakeup& publisher_;
+  Heartbeat& heartbeat_;
+  FusionCounters& counters_;
+  std::vector<NavState> produced_;
+};
+
+}  // namespace posed::pipeline

@@ -1,0 +1,41 @@
+#pragma once
+// The IMU stage (one thread): Source -> decoder chosen by the channel's wire format -> ClockSync
+// (device stamp -> host clock) -> the IMU queue to the fusion stage.
+
+#include "core/spsc_queue.hpp"
+#include "core/sync/clock_sync.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/stage_support.hpp"
+#include "daemon/pipeline/wakeup.hpp"
+#include "drivers/common/source.hpp"
+#include "drivers/imu/a9_protocol.hpp"
+
+namespace posed::pipeline {
+
+class ImuStage {
+ public:
+  ImuStage(const config::PosedConfig& config, drivers::Source& source, SpscQueue<ImuItem>& queue,
+           Wakeup& consumer, Heartbeat& heartbeat, StreamCounters& counters);
+  /// Runs until the Source ends (end of recording, or stopped), then forwards end-of-stream.
+  void run();
+
+ private:
+  void on_a9_frame(const drivers::a9::A9Frame& frame, HostTime arrival);
+  void count_malformed();
+  void publish_progress();
+
+  const config::PosedConfig& config_;
+  drivers::Source& source_;
+  SpscQueue<ImuItem>& queue_;
+  Wakeup& consumer_;
+  Heartbeat& heartbeat_;
+  StreamCounters& counters_;
+
+  drivers::a9::A9Decoder a9_decoder_;
+  drivers::a9::A9Mounting mounting_;
+  ClockSync clock_;
+  std::uint64_t malformed_seen_ = 0;
+  bool pushed_ = false;
+};
+
+}  // namespace posed::pipeline

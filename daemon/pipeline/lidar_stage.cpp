@@ -1,0 +1,94 @@
+#include "daemon/pipeline/lidar_stage.hpp"
+
+#include "daemon/pipeline/thread_policy.hpp"
+#include "drivers/common/log.hpp"
+#include "drivers/common/wire_format.hpp"
+
+namespace posed::pipeline {
+
+namespace velodyne = drivers::velodyne;
+
+std::size_t LidarStage::pool_buffers(const config::PosedConfig& config) {
+  return static_cast<std::size_t>(config.queues.scan_capacity) + 4;
+}
+
+LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration calibration,
+                       drivers::Source& source, SpscQueue<ScanItem>& queue, Wakeup& consumer,
+                       Heartbeat& heartbeat, StreamCounters& counters,
+                       LidarScanCounters& scan_counters)
+    : config_(config),
+      source_(source),
+      queue_(queue),
+      consumer_(consumer),
+      heartbeat_(heartbeat),
+      counters_(counters),
+      scan_counters_(scan_counters),
+      pool_(pool_buffers(config),
+            velodyne::max_points_per_scan(config.lidar.rpm) * sizeof(LidarPoint)),
+      builder_(std::move(calibration),
+               velodyne::ScanBuilderConfig{
+                   .decoder = {.min_range_m = config.lidar.min_range_m,
+                               .max_range_m = config.lidar.max_range_m},
+                   .clock = {.kind = clock_kind_from(config.lidar.clock_kind),
+                             .nominal_rate_hz = 1507.0,
+                             .latency = Duration::from_seconds(config.lidar.clock_latency_s)},
+                   .assembler = {.cut_azimuth_cdeg = static_cast<std::uint32_t>(
+                                     config.lidar.cut_azimuth_deg * 100)}},
+               pool_) {}
+
+void LidarStage::forward_scans() {
+  bool pushed = false;
+  while (builder_.pop(assembled_)) {
+    scan_counters_.scans.fetch_add(1, std::memory_order_relaxed);
+    scan_counters_.points.fetch_add(assembled_.scan.point_count, std::memory_order_relaxed);
+    const PushResult r = queue_.push(ScanItem{std::move(assembled_.scan), false});
+    if (r == PushResult::kRejectedFull || r == PushResult::kRejectedTimeout ||
+        r == PushResult::kPushedDropped) {
+      counters_.dropped.fetch_add(1, std::memory_order_relaxed);
+    }
+    pushed = true;
+  }
+  if (pushed) consumer_.signal();
+}
+
+void LidarStage::handle_position(const drivers::RawChunk& chunk) {
+  // The PPS state says whether the µs-past-the-hour is GPS-aligned.
+  if (builder_.add_position(chunk.bytes) && !reported_pps_) {
+    POSED_LOG_INFO("lidar: PPS locked, device time is GPS-aligned");
+    reported_pps_ = true;
+  }
+}
+
+void LidarStage::handle_data(const drivers::RawChunk& chunk) {
+  if (builder_.add_data(chunk.bytes, chunk.host_receive) != velodyne::DecodeStatus::kOk) {
+    counters_.malformed.store(builder_.decoder().counters().malformed(), std::memory_order_relaxed);
+    return;
+  }
+  const std::uint64_t decoded = counters_.decoded.fetch_add(1, std::memory_order_relaxed) + 1;
+  log_clock_event("lidar", builder_.clock().last_event());
+  forward_scans();
+  if (decoded % 64 == 0) counters_.publish_clock(builder_.clock().status());
+}
+
+void LidarStage::run() {
+  apply_thread_policy("posed-lidar", config_.threads.lidar_source);
+  drivers::RawChunk chunk;
+  SourceReader reader("lidar", source_, heartbeat_, counters_);
+  while (reader.next(chunk)) {
+    const std::string_view format = reader.wire_format(chunk);
+    if (format == drivers::wire::kVelodyneData) {
+      handle_data(chunk);
+    } else if (format == drivers::wire::kVelodynePosition) {
+      handle_position(chunk);
+    } else {
+      reader.undecodable(chunk);
+    }
+  }
+  builder_.flush();
+  forward_scans();
+  counters_.publish_clock(builder_.clock().status());
+  queue_.push(ScanItem{{}, true});
+  consumer_.signal();
+}
+
+}  // namespace posed::pipeline

@@ -1,0 +1,43 @@
+#pragma once
+// The pipeline's figures for rt/posed/status, the systemd STATUS= line and the exit summary.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/estimator/fusion_core.hpp"
+#include "core/estimator/nav_state.hpp"
+#include "core/time.hpp"
+
+namespace posed::pipeline {
+
+/// Per-stream figures.
+struct StreamStatus {
+  std::string name;
+  double rate_hz = 0;           ///< decoded per second between status messages (publisher only)
+  std::uint64_t received = 0;   ///< chunks read from the Source
+  std::uint64_t decoded = 0;    ///< measurements decoded
+  std::uint64_t dropped = 0;    ///< measurements dropped by the queue policy
+  std::uint64_t malformed = 0;  ///< frames rejected by the decoder (CRC, truncation, unknown)
+  std::int64_t clock_offset_ns = 0;  ///< host minus device time [ns]
+  double clock_drift_ppm = 0;        ///< device clock rate error [ppm]
+  double clock_jitter_ns = 0;        ///< spread of arrival delays [ns]
+  double clock_uncertainty_ns = 0;   ///< 1-sigma of the mapped stamps [ns]
+  std::string clock_state;           ///< converging | locked | lost
+  std::string health;                ///< ok | no_data | degraded | device_lost
+};
+
+struct PipelineStatus {
+  HostTime stamp;
+  EstimatorMode mode = EstimatorMode::kAligning;
+  std::vector<StreamStatus> streams;
+  std::uint64_t lidar_scans = 0;        ///< scans assembled
+  std::uint64_t lidar_points = 0;       ///< points in those scans
+  std::uint64_t lidar_scans_fused = 0;  ///< scans the fusion core received
+  /// the estimator's own figures (scans used, degeneracy, biases, re-initialisations)
+  FusionFigures estimator;
+  std::uint64_t states = 0;          ///< states produced by the fusion core
+  std::uint64_t states_dropped = 0;  ///< states dropped between fusion and publisher
+};
+
+}  // namespace posed::pipeline

@@ -1,0 +1,37 @@
+#pragma once
+// The publisher stage (one thread): hands every state to the daemon's output callback (DDS,
+// recorder) and, at the status rate, a status snapshot with per-stream rates.
+
+#include <functional>
+
+#include "core/spsc_queue.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/pipeline_status.hpp"
+#include "daemon/pipeline/stage_support.hpp"
+#include "daemon/pipeline/wakeup.hpp"
+
+namespace posed::pipeline {
+
+class PublisherStage {
+ public:
+  PublisherStage(const config::PosedConfig& config, SpscQueue<StateItem>& states, Wakeup& ready,
+                 Heartbeat& heartbeat, std::function<void(const NavState&)> on_state,
+                 std::function<void(const PipelineStatus&)> on_status,
+                 std::function<PipelineStatus()> snapshot);
+  /// Runs until end-of-stream arrives; a last status follows it.
+  void run();
+
+ private:
+  void publish_status();
+
+  const config::PosedConfig& config_;
+  SpscQueue<StateItem>& states_;
+  Wakeup& ready_;
+  Heartbeat& heartbeat_;
+  std::function<void(const NavState&)> on_state_;
+  std::function<void(const PipelineStatus&)> on_status_;
+  std::function<PipelineStatus()> snapshot_;
+  PipelineStatus previous_;
+};
+
+}  // namespace posed::pipeline

@@ -1,0 +1,36 @@
+#pragma once
+// Replay Sources for `posed --replay`: one McapReplaySource per stream found in the recording,
+// passed to the same Pipeline as the live Sources. They are not live, so the pipeline's queues
+// block instead of dropping and a replay at full speed is deterministic.
+
+#include <string>
+
+#include "core/time.hpp"
+#include "daemon/pipeline/source_factory.hpp"
+
+namespace posed::pipeline {
+
+struct ReplayOptions {
+  std::string path;
+  /// 1 = recorded timing, N = N times faster, 0 = as fast as the pipeline takes it
+  double rate = 1.0;
+  /// skip this much of the recording [s]
+  double start_s = 0;
+  /// replay only this much of it; 0 = to the end [s]
+  double duration_s = 0;
+  bool loop = false;
+};
+
+struct ReplaySources {
+  BuiltSources built;
+  /// the recording's wall-minus-host offset, so replayed poses carry the recorded wall time
+  HostToWall host_to_wall{};
+  bool have_host_to_wall = false;
+  /// streams found, e.g. "imu, lidar"
+  std::string streams;
+};
+
+/// On failure the sources are empty and `error` names the file and the problem.
+ReplaySources make_replay_sources(const ReplayOptions& options, std::string& error);
+
+}  // namespace posed::pipeline

@@ -1,0 +1,116 @@
+#pragma once
+// What the pipeline's stages share: the items on their queues (end-of-stream travels with the
+// data), per-stream counters that the status snapshot reads from another thread, heartbeats for
+// the systemd watchdog, and the small conversions every stage needs.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+
+#include "core/estimator/nav_state.hpp"
+#include "core/measurements.hpp"
+#include "core/spsc_queue.hpp"
+#include "core/sync/clock_sync.hpp"
+#include "core/time.hpp"
+#include "daemon/pipeline/pipeline_status.hpp"
+#include "drivers/common/source.hpp"
+
+namespace posed::pipeline {
+
+/// How long a consumer sleeps when its queues are empty before it heartbeats again.
+inline constexpr auto kStageWaitTimeout = std::chrono::milliseconds(50);
+/// How long a Source read waits before the stage heartbeats again.
+inline const Duration kStageReadTimeout = Duration::from_ms(100);
+
+struct ImuItem {
+  ImuSample sample;
+  bool end_of_stream = false;
+};
+struct ScanItem {
+  LidarScan scan;
+  bool end_of_stream = false;
+};
+struct StateItem {
+  NavState state;
+  bool end_of_stream = false;
+};
+
+/// The last sign of life of one stage thread, on the host clock.
+class Heartbeat {
+ public:
+  explicit Heartbeat(std::string name) : name_(std::move(name)) {}
+  void beat();
+  HostTime last() const { return HostTime::from_ns(ns_.load(std::memory_order_relaxed)); }
+  const std::string& name() const { return name_; }
+  void reset(HostTime now) { ns_.store(now.ns, std::memory_order_relaxed); }
+
+ private:
+  std::string name_;
+  std::atomic<std::int64_t> ns_{0};
+};
+
+/// One sensor stream's counters, written by its stage thread, read by status() from any thread.
+struct StreamCounters {
+  std::atomic<std::uint64_t> received{0};     ///< chunks read from the Source
+  std::atomic<std::uint64_t> decoded{0};      ///< measurements decoded
+  std::atomic<std::uint64_t> malformed{0};    ///< frames/packets the decoder rejected
+  std::atomic<std::uint64_t> dropped{0};      ///< measurements lost to a full queue or pool
+  std::atomic<std::uint64_t> undecodable{0};  ///< chunks of a wire format no decoder knows
+  std::atomic<bool> device_lost{false};
+
+  /// The clock figures, copied from the stage's ClockSync now and then.
+  void publish_clock(const ClockSyncStatus& clock);
+  ClockSyncStatus clock() const;
+
+ private:
+  mutable std::mutex clock_mutex_;
+  ClockSyncStatus clock_;
+};
+
+/// Fills `out` from the counters; `live`: arrival times are on this host's clock, so a second of
+/// silence means the stream is lost whatever the clock estimate said last.
+void fill_stream_status(StreamStatus& out, const StreamCounters& counters, HostTime now, bool live);
+
+/// The bookkeeping every source stage does around Source::read(): heartbeat, the device lost and
+/// back (logged once per transition), the received count, and chunks of a wire format the stage
+/// has no decoder for (counted, logged once).
+class SourceReader {
+ public:
+  SourceReader(std::string_view stream, drivers::Source& source, Heartbeat& heartbeat,
+               StreamCounters& counters)
+      : stream_(stream), source_(source), heartbeat_(heartbeat), counters_(counters) {}
+  /// Reads until data or the end: true with `chunk` filled, false once the Source has ended.
+  bool next(drivers::RawChunk& chunk);
+  /// The wire format of `chunk`'s channel.
+  std::string_view wire_format(const drivers::RawChunk& chunk) const {
+    return source_.wire_format(chunk.channel);
+  }
+  /// Counts a chunk no decoder of the stage understands; says so once.
+  void undecodable(const drivers::RawChunk& chunk);
+
+ private:
+  std::string_view stream_;
+  drivers::Source& source_;
+  Heartbeat& heartbeat_;
+  StreamCounters& counters_;
+  bool reported_lost_ = false;
+  bool reported_format_ = false;
+};
+
+/// The config's clock kind name ("counter_us_32bit", ...) as ClockSync's enum.
+DeviceClockKind clock_kind_from(const std::string& name);
+
+/// Live Sources must never wait for the pipeline (queues drop the oldest); recordings and
+/// generators must lose nothing, so their producer blocks instead (deterministic replays).
+DropPolicy queue_policy(const drivers::Source* source);
+/// How long a blocked producer of a recording waits before giving up on a stalled consumer.
+inline constexpr auto kReplayBlockTimeout = std::chrono::seconds(30);
+
+/// Logs a ClockSync event once per event ("imu clock: reset").
+void log_clock_event(std::string_view stream, ClockEvent event);
+
+}  // namespace posed::pipeline
