@@ -12,10 +12,24 @@ std::span<const Benchmark> benchmarks() {
   static const std::array kBenchmarks = {
       Benchmark{"queue", "SPSC queue: 64-byte items between two threads, throughput and latency",
                 bench_queue},
-      Benchmark{"imu", "A9 parser throughput; serial pty write -> decoded sample latency", bench_imu},
-      Benchmark{"sync", "ClockSync: stamp error, re-lock and cost on simulated sensor clocks", bench_sync},
-      Benchmark{"velodyne", "Velodyne decode rate and loopback UDP receive at 15k packets/s", bench_velodyne},
-      Benchmark{"dds", "DDS odom 400 Hz publish -> receive latency, two participants, loopback", bench_dds},
+      Benchmark{"imu", "A9 parser throughput; serial pty write -> decoded sample latency",
+                bench_imu},
+      Benchmark{"sync", "ClockSync: stamp error, re-lock and cost on simulated sensor clocks",
+                bench_sync},
+      Benchmark{"velodyne", "Velodyne decode rate and loopback UDP receive at 15k packets/s",
+                bench_velodyne},
+      Benchmark{"dds", "DDS odom 400 Hz publish -> receive latency, two participants, loopback",
+                bench_dds},
+      Benchmark{"camera", "Camera decode per frame: YUYV->BGR, Z16, Y16 AGC, MJPEG (one core)",
+                bench_camera},
+      Benchmark{"sim",
+                "Simulator real-time factor on one core: all sensors, lidar+IMU, cameras+IMU",
+                bench_sim},
+      Benchmark{"lio",
+                "Lidar-inertial estimator per scan on one core, by step (simulated VLP-32C + A9)",
+                bench_lio},
+      Benchmark{"recording", "MCAP write (lz4, one core) and read throughput on /dev/shm",
+                bench_recording},
   };
   return kBenchmarks;
 }

@@ -31,5 +31,9 @@ int bench_imu();
 int bench_sync();
 int bench_velodyne();
 int bench_dds();
+int bench_camera();
+int bench_recording();
+int bench_sim();
+int bench_lio();
 
 }  // namespace posed::posectl

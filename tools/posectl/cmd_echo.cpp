@@ -6,9 +6,12 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,6 +62,12 @@ double percentile(std::vector<double> values, double p) {
   return values[static_cast<std::size_t>(p * static_cast<double>(values.size() - 1) + 0.5)];
 }
 
+/// A replay stamps its poses with the recording's wall time: receipt minus stamp is then the age
+/// of the recording, not a latency, and is not reported as one.
+constexpr const char* kNotCurrent =
+    "latency n/a (stamps are over an hour off this host's clock: a replayed recording?)";
+bool stamps_are_current(double latency_ms) { return std::abs(latency_ms) < 3600e3; }
+
 /// Receive rate and latency, over the window since the last report and over the whole run.
 struct EchoStats {
   std::vector<double> latency_ms_all;
@@ -84,9 +93,15 @@ struct EchoStats {
     } else {
       std::vector<double> window(latency_ms_all.begin() + static_cast<std::ptrdiff_t>(window_start),
                                  latency_ms_all.end());
-      std::fprintf(out, "# %s: %.1f Hz, latency p50 %.3f ms p99 %.3f ms (%zu samples in %.1f s)\n",
-                   topic, static_cast<double>(n) / seconds, percentile(window, 0.50),
-                   percentile(window, 0.99), n, seconds);
+      const double p50 = percentile(window, 0.50);
+      if (stamps_are_current(p50)) {
+        std::fprintf(
+            out, "# %s: %.1f Hz, latency p50 %.3f ms p99 %.3f ms (%zu samples in %.1f s)\n", topic,
+            static_cast<double>(n) / seconds, p50, percentile(window, 0.99), n, seconds);
+      } else {
+        std::fprintf(out, "# %s: %.1f Hz (%zu samples in %.1f s), %s\n", topic,
+                     static_cast<double>(n) / seconds, n, seconds, kNotCurrent);
+      }
     }
     std::fflush(out);
     window_start = latency_ms_all.size();
@@ -101,13 +116,18 @@ struct EchoStats {
     }
     const double span = (last_receive - first_receive).seconds();
     const double rate = count() >= 2 && span > 0 ? static_cast<double>(count() - 1) / span : 0.0;
-    std::fprintf(
-        out,
-        "# summary %s: %zu samples, rate %.2f Hz, latency p50 %.3f ms p99 %.3f ms "
-        "max %.3f ms\n",
-        topic, count(), rate, percentile(latency_ms_all, 0.50), percentile(latency_ms_all, 0.99),
-        latency_ms_all.empty() ? NAN
-                               : *std::max_element(latency_ms_all.begin(), latency_ms_all.end()));
+    const double p50 = percentile(latency_ms_all, 0.50);
+    if (!stamps_are_current(p50)) {
+      std::fprintf(out, "# summary %s: %zu samples, rate %.2f Hz, %s\n", topic, count(), rate,
+                   kNotCurrent);
+      std::fflush(out);
+      return;
+    }
+    std::fprintf(out,
+                 "# summary %s: %zu samples, rate %.2f Hz, latency p50 %.3f ms p99 %.3f ms "
+                 "max %.3f ms\n",
+                 topic, count(), rate, p50, percentile(latency_ms_all, 0.99),
+                 *std::max_element(latency_ms_all.begin(), latency_ms_all.end()));
     std::fflush(out);
   }
 };
@@ -195,6 +215,19 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
   std::printf("status %s s  %s  mode %s  uptime %.1f s  latency %.3f ms  %s\n",
               stamp_text(m.stamp).c_str(), m.version.c_str(), m.estimator_mode.c_str(), m.uptime_s,
               lat, m.summary.c_str());
+  const dds::EstimatorStatusMessage& e = m.estimator;
+  std::printf(
+      "  estimator  scans used %llu rejected %llu degenerate %llu skipped %llu  keyframes %llu  "
+      "re-initialisations %llu  last match %d degenerate directions  bias gyro [%.5f %.5f %.5f] "
+      "rad/s accel [%.4f %.4f %.4f] m/s^2\n",
+      static_cast<unsigned long long>(e.scans_used),
+      static_cast<unsigned long long>(e.scans_rejected),
+      static_cast<unsigned long long>(e.scans_degenerate),
+      static_cast<unsigned long long>(e.scans_skipped),
+      static_cast<unsigned long long>(e.keyframes),
+      static_cast<unsigned long long>(e.reinitialisations), e.degenerate_directions,
+      e.gyro_bias_radps.x(), e.gyro_bias_radps.y(), e.gyro_bias_radps.z(), e.accel_bias_mps2.x(),
+      e.accel_bias_mps2.y(), e.accel_bias_mps2.z());
   for (const auto& s : m.streams) {
     std::printf(
         "  %-10s %8.2f Hz  received %llu decoded %llu dropped %llu malformed %llu  clock %s: "
@@ -207,15 +240,35 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
   }
 }
 
+/// `--tum FILE`: poses as a TUM trajectory (`stamp x y z qx qy qz qw`, stamp [s] wall time, as
+/// posed stamps them), for `posectl eval` against ground truth.
+void write_tum(std::FILE* tum, WallTime stamp, const Eigen::Vector3d& p,
+               const Eigen::Quaterniond& q) {
+  std::fprintf(tum, "%s %.6f %.6f %.6f %.9f %.9f %.9f %.9f\n", stamp_text(stamp).c_str(), p.x(),
+               p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+}
+void write_tum(std::FILE* tum, const dds::Received<dds::OdomMessage>& r) {
+  write_tum(tum, r.msg.stamp, r.msg.p_map_base_m, r.msg.q_map_base);
+}
+void write_tum(std::FILE* tum, const dds::Received<dds::PoseMessage>& r) {
+  write_tum(tum, r.msg.stamp, r.msg.p_map_base_m, r.msg.q_map_base);
+}
+void write_tum(std::FILE*, const dds::Received<dds::StatusMessage>&) {}
+
 /// Takes everything waiting on `topic`, prints it, feeds the stats; returns how many.
 template <class Message, class Take, class Print>
-std::size_t drain(Take take, Print print, bool as_csv, EchoStats& stats, std::size_t limit) {
+std::size_t drain(Take take, Print print, bool as_csv, std::FILE* tum, EchoStats& stats,
+                  std::size_t limit) {
   std::vector<dds::Received<Message>> samples;
   take(samples);
   std::size_t printed = 0;
   for (const auto& r : samples) {
     if (limit != 0 && stats.count() >= limit) break;  // exactly --count lines
-    print(r, as_csv);
+    if (tum != nullptr) {
+      write_tum(tum, r);
+    } else {
+      print(r, as_csv);
+    }
     stats.add(r.msg.stamp, r.received_wall, r.received_host);
     ++printed;
   }
@@ -236,6 +289,7 @@ int run_echo(int argc, char** argv) {
   double timeout_s = 0.0;
   std::uint32_t domain = 0;
   std::string cyclone_config;
+  std::string tum_path;
   app.add_option("topic", topic_arg,
                  "odom, pose, status, or the full DDS name (rt/posed/odom) or ROS name")
       ->capture_default_str();
@@ -250,6 +304,9 @@ int run_echo(int argc, char** argv) {
   app.add_option("--cyclonedds-config", cyclone_config,
                  "Cyclone XML file (e.g. config/cyclonedds-loopback.xml); default: CYCLONEDDS_URI "
                  "or Cyclone's built-in defaults");
+  app.add_option("--tum", tum_path,
+                 "write odom/pose samples to this file as a TUM trajectory (stamp [s] x y z qx qy "
+                 "qz qw) instead of printing them; for `posectl eval`");
   CLI11_PARSE(app, argc, argv);
 
   dds::Topic topic = dds::Topic::kOdom;
@@ -261,6 +318,19 @@ int run_echo(int argc, char** argv) {
     return 2;
   }
   const std::string topic_name(dds::topic_name(topic));
+  if (!tum_path.empty() && topic == dds::Topic::kStatus) {
+    std::fprintf(stderr, "posectl echo: --tum needs a pose topic (odom or pose), not status\n");
+    return 2;
+  }
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> tum(nullptr, &std::fclose);
+  if (!tum_path.empty()) {
+    tum.reset(std::fopen(tum_path.c_str(), "w"));
+    if (!tum) {
+      std::fprintf(stderr, "posectl echo: cannot write %s: %s\n", tum_path.c_str(),
+                   std::strerror(errno));
+      return 1;
+    }
+  }
 
   dds::DdsConfig config;
   config.domain_id = domain;
@@ -276,7 +346,7 @@ int run_echo(int argc, char** argv) {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
   std::FILE* report_out = as_csv ? stderr : stdout;
-  if (as_csv) {
+  if (as_csv && !tum) {
     if (topic == dds::Topic::kOdom) print_odom_header_csv();
     if (topic == dds::Topic::kPose) print_pose_header_csv();
     if (topic == dds::Topic::kStatus) print_status_header_csv();
@@ -304,15 +374,15 @@ int run_echo(int argc, char** argv) {
     switch (topic) {
       case dds::Topic::kOdom:
         drain<dds::OdomMessage>([&](auto& v) { subscriber->take_odom(v); }, print_odom, as_csv,
-                                stats, count);
+                                tum.get(), stats, count);
         break;
       case dds::Topic::kPose:
         drain<dds::PoseMessage>([&](auto& v) { subscriber->take_pose(v); }, print_pose, as_csv,
-                                stats, count);
+                                tum.get(), stats, count);
         break;
       case dds::Topic::kStatus:
         drain<dds::StatusMessage>([&](auto& v) { subscriber->take_status(v); }, print_status,
-                                  as_csv, stats, count);
+                                  as_csv, nullptr, stats, count);
         break;
     }
   }

@@ -7,8 +7,16 @@ namespace posed::posectl {
 std::span<const Command> commands() {
   static const std::array kCommands = {
       Command{"bench", "run benchmarks; prints `NAME METRIC VALUE UNIT` lines", run_bench},
-      Command{"inspect", "decode a raw sensor capture: one line per frame, then a summary", run_inspect},
-      Command{"echo", "print posed's DDS topics (odom, pose, status) with rate and latency", run_echo},
+      Command{"inspect", "decode a raw sensor capture: one line per frame, then a summary",
+              run_inspect},
+      Command{"echo", "print posed's DDS topics (odom, pose, status) with rate and latency",
+              run_echo},
+      Command{"eval", "ATE and RPE of an estimated trajectory against ground truth (TUM, KITTI)",
+              run_eval},
+      Command{"sim",
+              "simulate the rig in a scenario: a recording with raw sensor data and ground truth",
+              run_sim},
+      Command{"export", "write poses of an MCAP recording as a TUM trajectory", run_export},
   };
   return kCommands;
 }

@@ -1,0 +1,143 @@
+// posectl bench lio: per-scan cost of the lidar-inertial estimator on one core, with the
+// breakdown by step, on simulated VLP-32C scans (~55k points) and A9 samples of the default rig
+// driving `street_night`, decoded by the real drivers. Also the trajectory error of that run.
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "core/estimator/lio_estimator.hpp"
+#include "daemon/config/config_loader.hpp"
+#include "daemon/pipeline/estimator_config.hpp"
+#include "drivers/velodyne/scan_builder.hpp"
+#include "tools/posectl/bench.hpp"
+#include "tools/sim/lidar_imu_run.hpp"
+#include "tools/sim/rig_config.hpp"
+
+namespace posed::posectl {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Times every step of every scan.
+class StepTimer final : public estimator::LioStepProbe {
+ public:
+  void begin(estimator::LioStep step) override { start_[index(step)] = Clock::now(); }
+  void end(estimator::LioStep step) override {
+    const std::size_t i = index(step);
+    current_[i] += std::chrono::duration<double, std::milli>(Clock::now() - start_[i]).count();
+    touched_ = true;
+  }
+  /// Closes the scan in progress (if any step ran): its per-step times join the records.
+  void finish_scan() {
+    if (!touched_) return;
+    double total = 0;
+    for (std::size_t i = 0; i < current_.size(); ++i) {
+      per_step_[i].push_back(current_[i]);
+      total += current_[i];
+      current_[i] = 0;
+    }
+    totals_.push_back(total);
+    touched_ = false;
+  }
+  const std::vector<double>& step(std::size_t i) const { return per_step_[i]; }
+  const std::vector<double>& totals() const { return totals_; }
+
+ private:
+  static std::size_t index(estimator::LioStep s) { return static_cast<std::size_t>(s); }
+  std::array<Clock::time_point, 6> start_{};
+  std::array<double, 6> current_{};
+  std::array<std::vector<double>, 6> per_step_;
+  std::vector<double> totals_;
+  bool touched_ = false;
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
+}  // namespace
+
+int bench_lio() {
+  const config::PosedConfig config = config::default_config();  // the M2DGR rig
+  sim::SimOptions options;
+  options.scenario = "street_night";
+  options.duration_s = 40.0;
+  options.seed = 3;
+  std::fprintf(stderr, "posectl bench lio: simulating %s for %.0f s (lidar + IMU)...\n",
+               options.scenario.c_str(), options.duration_s);
+  sim::LidarImuRun run;
+  std::string error;
+  if (!sim::simulate_lidar_imu(sim::rig_from_config(config), options, run, error)) {
+    std::fprintf(stderr, "posectl bench lio: %s\n", error.c_str());
+    return 1;
+  }
+  estimator::LioEstimator lio(pipeline::lio_config(config));
+  StepTimer timer;
+  lio.set_probe(&timer);
+  PayloadPool pool(4,
+                   drivers::velodyne::max_points_per_scan(config.lidar.rpm) * sizeof(LidarPoint));
+  std::vector<NavState> states;
+  std::size_t next_scan = 0;
+  double points = 0;
+  std::fprintf(stderr, "posectl bench lio: %zu scans through the estimator...\n", run.scans.size());
+  for (const ImuSample& imu : run.imu) {
+    while (next_scan < run.scans.size() && run.scans[next_scan].end < imu.stamp) {
+      const sim::DecodedScan& s = run.scans[next_scan++];
+      LidarScan scan;
+      scan.start_stamp = s.start;
+      scan.end_stamp = s.end;
+      scan.points = pool.acquire();
+      std::copy(s.points.begin(), s.points.end(), scan.points.as<LidarPoint>().begin());
+      scan.point_count = static_cast<std::uint32_t>(s.points.size());
+      points += static_cast<double>(s.points.size());
+      lio.add_scan(std::move(scan), states);
+      timer.finish_scan();
+    }
+    lio.add_imu(imu, states);  // releases the scan the IMU now covers
+    timer.finish_scan();
+  }
+
+  // Trajectory error of the optimised poses, after the best rigid alignment.
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs;
+  for (const NavState& s : states) {
+    if (s.optimised) pairs.emplace_back(s.p_map_base_m, run.T_map_base(s.stamp).translation());
+  }
+  Eigen::Vector3d me = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
+  for (const auto& [e, g] : pairs) {
+    me += e;
+    mg += g;
+  }
+  const double n = std::max<double>(1.0, static_cast<double>(pairs.size()));
+  me /= n;
+  mg /= n;
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (const auto& [e, g] : pairs) C += (g - mg) * (e - me).transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
+  const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
+  double sq = 0;
+  for (const auto& [e, g] : pairs) sq += (R * (e - me) + mg - g).squaredNorm();
+
+  const std::vector<double>& totals = timer.totals();
+  report("lio", "scans", static_cast<double>(totals.size()), "count");
+  report("lio", "points_per_scan_mean",
+         points / std::max<double>(1.0, static_cast<double>(run.scans.size())), "points");
+  for (std::size_t i = 0; i < estimator::kLioStepNames.size(); ++i) {
+    const std::string name(estimator::kLioStepNames[i]);
+    report("lio", name + "_median", percentile(timer.step(i), 0.5), "ms");
+    report("lio", name + "_p99", percentile(timer.step(i), 0.99), "ms");
+  }
+  report("lio", "per_scan_median", percentile(totals, 0.5), "ms");
+  report("lio", "per_scan_p99", percentile(totals, 0.99), "ms");
+  report("lio", "per_scan_max", percentile(totals, 1.0), "ms");
+  report("lio", "ate_rmse", std::sqrt(sq / n), "m");
+  return 0;
+}
+
+}  // namespace posed::posectl

@@ -1,0 +1,218 @@
+// posectl sim: simulates the rig of config/posed.yaml driving through a scenario and writes what
+// its sensors would have sent as a posed recording (MCAP: the raw channels a live recording has,
+// plus the ground truth), and optionally the ground truth as a TUM file. docs/simulator.md.
+// Exit codes: 0 ok, 1 the simulation or the recording failed, 2 bad arguments or config.
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "daemon/config/config_loader.hpp"
+#include "drivers/recording/recorder.hpp"
+#include "tools/posectl/commands.hpp"
+#include "tools/sim/rig_config.hpp"
+#include "tools/sim/scenarios.hpp"
+#include "tools/sim/simulator.hpp"
+
+namespace posed::posectl {
+namespace {
+
+/// The simulator's output into a posed recording, and the ground truth into a TUM file.
+class RecorderSink : public sim::SimSink {
+ public:
+  RecorderSink(drivers::recording::Recorder& recorder, std::ofstream* tum, HostToWall to_wall)
+      : recorder_(recorder), tum_(tum), to_wall_(to_wall) {}
+
+  int add_stream(const sim::SimStream& s) override {
+    const std::uint16_t id =
+        recorder_.add_raw_channel(s.name, s.wire_format, s.metadata, s.source_channel);
+    if (id == drivers::recording::Recorder::kInvalidChannel) return -1;
+    ids_.push_back(id);
+    channels_.push_back(s.source_channel);
+    return static_cast<int>(ids_.size() - 1);
+  }
+
+  bool write_raw(int stream, HostTime host_time, std::span<const std::byte> bytes) override {
+    const auto i = static_cast<std::size_t>(stream);
+    const drivers::RawChunk chunk{bytes, host_time, channels_[i]};
+    // The simulator runs faster than real time: when the writer thread falls behind, wait for
+    // it instead of losing data (the Recorder's drop-newest policy is for live Sources).
+    for (int tries = 0; !recorder_.record(ids_[i], chunk); ++tries) {
+      if (tries > 20000) return false;  // 20 s without progress: the disk is gone
+      ++waits_;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
+  }
+
+  bool write_ground_truth(HostTime stamp, const sim::GroundTruthPose& pose) override {
+    const Eigen::Vector3d& p = pose.p_map_base_m;
+    const Eigen::Quaterniond& q = pose.q_map_base;
+    const Eigen::Vector3d v_base = q.conjugate() * pose.v_map_mps;
+    if (!recorder_.write_odometry(
+            "/posed/ground_truth", to_wall_(stamp), "map", "base_link", {p.x(), p.y(), p.z()},
+            {q.x(), q.y(), q.z(), q.w()}, {v_base.x(), v_base.y(), v_base.z()},
+            {pose.w_base_radps.x(), pose.w_base_radps.y(), pose.w_base_radps.z()})) {
+      return false;
+    }
+    if (tum_ != nullptr) {
+      // Wall time, as posed stamps its DDS messages when replaying this recording (it applies the
+      // recording's host-to-wall offset), so poses captured from DDS line up without an offset.
+      const WallTime wall = to_wall_(stamp);
+      char line[256];
+      std::snprintf(line, sizeof line, "%lld.%09lld %.6f %.6f %.6f %.9f %.9f %.9f %.9f\n",
+                    static_cast<long long>(wall.ns / 1'000'000'000),
+                    static_cast<long long>(wall.ns % 1'000'000'000), p.x(), p.y(), p.z(), q.x(),
+                    q.y(), q.z(), q.w());
+      *tum_ << line;
+      if (!*tum_) return false;
+    }
+    return true;
+  }
+
+  /// times record() refused because the writer's queue was full (each was retried)
+  std::uint64_t waits() const { return waits_; }
+
+ private:
+  drivers::recording::Recorder& recorder_;
+  std::ofstream* tum_;
+  HostToWall to_wall_;
+  std::vector<std::uint16_t> ids_;
+  std::vector<std::uint32_t> channels_;
+  std::uint64_t waits_ = 0;
+};
+
+}  // namespace
+
+int run_sim(int argc, char** argv) {
+  std::string scenarios;
+  for (std::string_view n : sim::scenario_names())
+    scenarios += (scenarios.empty() ? "" : ", ") + std::string(n);
+  CLI::App app{
+      "Simulates the rig of the config (VLP-32C, A9, D435i colour, PLUG 617 thermal) driving "
+      "through a scenario and writes a posed recording: the sensors' raw bytes on the channels a "
+      "live recording has, stamped with host arrival time, plus the ground truth (base_link in "
+      "map) as nav_msgs/Odometry on /posed/ground_truth. Deterministic for a seed.\n"
+      "Scenarios: " +
+          scenarios + " (docs/simulator.md).",
+      "posectl sim"};
+  std::string scenario = "room", out_path, gt_path, config_path = "config/posed.yaml";
+  double duration_s = 60.0;
+  std::uint64_t seed = 1;
+  bool no_cameras = false, no_lidar = false, no_noise = false;
+  app.add_option("--scenario", scenario, "world and drive: " + scenarios)->capture_default_str();
+  app.add_option("--duration", duration_s, "simulated time [s]")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "seed: same seed, same bytes; another, another world")
+      ->capture_default_str();
+  app.add_option("-o,--output", out_path, "recording to write (MCAP)")->required();
+  app.add_option(
+      "--gt", gt_path,
+      "also write the ground truth as TUM (stamp [s, wall time as posed --replay stamps its "
+      "poses] x y z qx qy qz qw)");
+  app.add_option("--config", config_path, "the rig: extrinsics, rates, IMU noise, intrinsics")
+      ->capture_default_str();
+  app.add_flag("--no-cameras", no_cameras, "lidar and IMU only (cameras cost most of the time)");
+  app.add_flag("--no-lidar", no_lidar, "no lidar");
+  app.add_flag("--no-noise", no_noise, "ideal sensors: no noise, jitter or dropouts");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  const config::LoadResult loaded = config::load_config_file(config_path);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "posectl sim: %s", loaded.error_text().c_str());
+    return 2;
+  }
+  const sim::SimRig rig = sim::rig_from_config(loaded.config);
+  sim::SimOptions options;
+  options.scenario = scenario;
+  options.duration_s = duration_s;
+  options.seed = seed;
+  options.lidar = !no_lidar;
+  options.visible_camera = options.thermal_camera = !no_cameras;
+  options.noise = !no_noise;
+  std::string error;
+  {
+    std::string e;
+    if (!sim::make_scenario(scenario, seed, 1.0, rig.gravity_mps2, e)) {
+      std::fprintf(stderr, "posectl sim: %s\n", e.c_str());
+      return 2;
+    }
+  }
+
+  drivers::recording::RecorderOptions ropt;
+  // A fixed host-to-wall offset (not the machine's clock) keeps the file a function of the seed.
+  ropt.host_to_wall = HostToWall{Duration::from_ns(sim::kSimWallStartNs - options.host_epoch_ns)};
+  drivers::recording::Recorder recorder;
+  if (!recorder.open(out_path, ropt, error)) {
+    std::fprintf(stderr, "posectl sim: %s\n", error.c_str());
+    return 1;
+  }
+  std::ofstream tum;
+  if (!gt_path.empty()) {
+    tum.open(gt_path);
+    if (!tum) {
+      std::fprintf(stderr, "posectl sim: cannot write %s\n", gt_path.c_str());
+      return 1;
+    }
+    tum << "# posectl sim --scenario " << scenario << " --seed " << seed
+        << ": base_link in map; stamp = wall time [s] (the recording's log time + its "
+           "host-to-wall offset, as posed --replay stamps DDS messages)\n";
+  }
+  RecorderSink sink(recorder, gt_path.empty() ? nullptr : &tum, ropt.host_to_wall);
+  sim::SimSummary summary;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto progress = [&](double done_s) {
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::fprintf(stderr, "\rposectl sim: %.0f / %.0f s simulated, %.2fx real time   ", done_s,
+                 duration_s, done_s / std::max(wall, 1e-9));
+    return true;
+  };
+  const bool ok = sim::run_simulation(rig, options, sink, summary, error, progress);
+  std::fprintf(stderr, "\n");
+  const bool closed = recorder.close();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!ok) {
+    std::fprintf(stderr, "posectl sim: %s\n", error.c_str());
+    return 1;
+  }
+  if (!closed) {
+    std::fprintf(stderr, "posectl sim: %s\n", recorder.error().c_str());
+    return 1;
+  }
+  const auto counters = recorder.counters();
+  std::printf(
+      "posectl sim: %s seed %llu, %.1f s simulated in %.1f s (%.2fx real time), %llu boxes, "
+      "loop %.0f m, driven %.0f m\n"
+      "  lidar %llu packets (%llu rays, %.1f %% returns), %llu position packets; imu %llu frames; "
+      "visible %llu frames; thermal %llu frames; ground truth %llu poses\n"
+      "  %s: %llu messages, %.1f MB%s%s\n",
+      scenario.c_str(), static_cast<unsigned long long>(seed), duration_s, wall,
+      duration_s / std::max(wall, 1e-9), static_cast<unsigned long long>(summary.boxes),
+      summary.path_length_m, summary.distance_m,
+      static_cast<unsigned long long>(summary.lidar_packets),
+      static_cast<unsigned long long>(summary.lidar_rays),
+      summary.lidar_rays > 0 ? 100.0 * static_cast<double>(summary.lidar_returns) /
+                                   static_cast<double>(summary.lidar_rays)
+                             : 0.0,
+      static_cast<unsigned long long>(summary.position_packets),
+      static_cast<unsigned long long>(summary.imu_frames),
+      static_cast<unsigned long long>(summary.visible_frames),
+      static_cast<unsigned long long>(summary.thermal_frames),
+      static_cast<unsigned long long>(summary.ground_truth_poses), out_path.c_str(),
+      static_cast<unsigned long long>(counters.messages_written),
+      static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",
+      gt_path.c_str());
+  return 0;
+}
+
+}  // namespace posed::posectl

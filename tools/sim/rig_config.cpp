@@ -1,0 +1,37 @@
+#include "tools/sim/rig_config.hpp"
+
+#include "daemon/pipeline/estimator_config.hpp"
+
+namespace posed::sim {
+namespace {
+
+CameraIntrinsics to_intrinsics(const config::CameraSection& c) {
+  return {c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2};
+}
+
+}  // namespace
+
+SimRig rig_from_config(const config::PosedConfig& cfg) {
+  SimRig rig;
+  rig.T_imu_lidar = pipeline::to_isometry(cfg.extrinsics.T_imu_lidar);
+  rig.T_imu_cam = pipeline::to_isometry(cfg.extrinsics.T_imu_cam);
+  rig.T_cam_thermal = pipeline::to_isometry(cfg.extrinsics.T_cam_thermal);
+  rig.imu.rate_hz = cfg.imu.rate_hz;
+  rig.imu.gyro_noise_density = cfg.imu.gyro_noise_density;
+  rig.imu.gyro_random_walk = cfg.imu.gyro_random_walk;
+  rig.imu.accel_noise_density = cfg.imu.accel_noise_density;
+  rig.imu.accel_random_walk = cfg.imu.accel_random_walk;
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t c = 0; c < 3; ++c)
+      rig.imu.mounting.R_imu_sensor[r][c] = cfg.imu.R_imu_sensor[3 * r + c];
+  rig.gravity_mps2 = cfg.imu.gravity_mps2;
+  rig.lidar_rpm = cfg.lidar.rpm;
+  rig.visible = to_intrinsics(cfg.visible_camera);
+  rig.visible_rate_hz = cfg.visible_camera.rate_hz;
+  rig.thermal = to_intrinsics(cfg.thermal_camera);
+  rig.thermal_rate_hz = cfg.thermal_camera.rate_hz;
+  rig.thermal_latency_s = cfg.thermal_camera.latency_s;
+  return rig;
+}
+
+}  // namespace posed::sim

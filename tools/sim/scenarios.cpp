@@ -1,0 +1,352 @@
+#include "tools/sim/scenarios.hpp"
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace posed::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+using Rng = std::mt19937_64;
+
+double uniform(Rng& rng, double a, double b) {
+  return std::uniform_real_distribution<double>(a, b)(rng);
+}
+
+/// Holds and quintic ramps between random cruise speeds, with stops, after a static start.
+SpeedProfile make_speed(Rng& rng, double duration_s, double static_s, double v_min, double v_max,
+                        double accel_mps2, double stop_probability) {
+  std::vector<SpeedRamp> ramps;
+  double t = static_s, speed = 0;
+  while (t < duration_s + 5.0) {
+    double target = uniform(rng, v_min, v_max);
+    if (speed > 0 && uniform(rng, 0, 1) < stop_probability) target = 0;
+    // Peak acceleration of a quintic ramp is 1.875 Δv / T.
+    const double T = std::max(1.0, 1.875 * std::abs(target - speed) / accel_mps2);
+    ramps.push_back({t, T, speed, target, 0});
+    t += T + (target == 0 ? uniform(rng, 1.0, 3.0) : uniform(rng, 3.0, 10.0));
+    speed = target;
+  }
+  return SpeedProfile(std::move(ramps));
+}
+
+std::vector<Wobble> make_wobble(Rng& rng, double amplitude) {
+  std::vector<Wobble> w;
+  for (int k = 0; k < 3; ++k) {
+    w.push_back({amplitude * uniform(rng, 0.5, 1.0) / std::sqrt(3.0),
+                 2 * kPi * uniform(rng, 0.7, 3.0), uniform(rng, 0, 2 * kPi)});
+  }
+  return w;
+}
+
+TrajectoryConfig make_bumps(Rng& rng, double z_m, double angle_rad, double gravity) {
+  TrajectoryConfig c;
+  c.gravity_mps2 = gravity;
+  c.z_wobble = make_wobble(rng, z_m);
+  c.roll_wobble = make_wobble(rng, angle_rad);
+  c.pitch_wobble = make_wobble(rng, angle_rad);
+  return c;
+}
+
+/// A closed loop around the origin: `n` waypoints at radius r·(1 + jitter) per axis scale.
+std::vector<Eigen::Vector2d> loop_waypoints(Rng& rng, int n, double rx, double ry, double jitter) {
+  std::vector<Eigen::Vector2d> pts;
+  const double phase = uniform(rng, 0, 2 * kPi);
+  for (int i = 0; i < n; ++i) {
+    const double a = phase + 2 * kPi * i / n;
+    const double r = 1.0 + uniform(rng, -jitter, jitter);
+    pts.emplace_back(rx * r * std::cos(a), ry * r * std::sin(a));
+  }
+  return pts;
+}
+
+/// Points along the path every `step_m`, for clearance checks.
+std::vector<Eigen::Vector2d> sample_path(const PeriodicSpline2& path, double step_m) {
+  std::vector<Eigen::Vector2d> out;
+  Eigen::Vector2d p, d1, d2, d3;
+  for (double u = 0; u < path.length(); u += step_m) {
+    path.eval(u, p, d1, d2, d3);
+    out.push_back(p);
+  }
+  return out;
+}
+
+/// Whether a yawed box footprint stays `clearance_m` away from every path sample.
+bool clear_of_path(const std::vector<Eigen::Vector2d>& samples, const Eigen::Vector2d& c, double hx,
+                   double hy, double yaw, double clearance_m) {
+  const double cy = std::cos(yaw), sy = std::sin(yaw);
+  for (const Eigen::Vector2d& s : samples) {
+    const Eigen::Vector2d d = s - c;
+    const double x = cy * d.x() + sy * d.y(), y = -sy * d.x() + cy * d.y();
+    const double dx = std::max(std::abs(x) - hx, 0.0), dy = std::max(std::abs(y) - hy, 0.0);
+    if (dx * dx + dy * dy < clearance_m * clearance_m) return false;
+  }
+  return true;
+}
+
+/// Frame of the path at u: point, unit tangent, left normal, heading.
+struct PathFrame {
+  Eigen::Vector2d p, t, n;
+  double yaw;
+};
+PathFrame path_frame(const PeriodicSpline2& path, double u) {
+  Eigen::Vector2d p, d1, d2, d3;
+  path.eval(u, p, d1, d2, d3);
+  const Eigen::Vector2d t = d1.normalized();
+  return {p, t, {-t.y(), t.x()}, std::atan2(t.y(), t.x())};
+}
+
+void add_ground(World& w, std::uint32_t material) {
+  w.add_aabb({-600, -600, -0.3}, {600, 600, 0}, material);
+}
+
+Scenario room(std::uint64_t seed, double duration_s, double g) {
+  Rng rng(seed * 0x9E3779B97F4A7C15ull + 1);
+  Scenario s;
+  s.name = "room";
+  World& w = s.world;
+  w.ambient = 0.6;
+  w.sky_radiance = 0.3;
+  w.air_temperature_c = 22;
+  w.sky_temperature_c = 21;  // no sky indoors; rays that escape see a ceiling-like temperature
+  const auto floor = w.add_material({35, 0.45, kTextureNoise, 0.35, 21, 0, {0.7, 0.8, 0.9}});
+  const auto wall = w.add_material({60, 0.75, kTextureNoise, 0.1, 22, 0, {0.9, 0.95, 1.0}});
+  const auto poster = w.add_material({45, 0.6, kTextureChecker, 0.8, 22, 0, {1, 1, 1}});
+  const auto wood = w.add_material({30, 0.4, kTextureNoise, 0.5, 22, 0, {0.3, 0.5, 0.7}});
+  const auto computer = w.add_material({20, 0.15, kTexturePlain, 0, 38, 0, {0.5, 0.5, 0.5}});
+  const auto lamp = w.add_material({70, 0.9, kTexturePlain, 0, 45, 3.0, {0.9, 1, 1}});
+  add_ground(w, floor);
+  const double hx = uniform(rng, 3.5, 5.0), hy = uniform(rng, 2.5, 4.0), h = 2.8;
+  w.add_aabb({-hx - 0.2, -hy - 0.2, 0}, {-hx, hy + 0.2, h}, wall);
+  w.add_aabb({hx, -hy - 0.2, 0}, {hx + 0.2, hy + 0.2, h}, wall);
+  w.add_aabb({-hx, -hy - 0.2, 0}, {hx, -hy, h}, wall);
+  w.add_aabb({-hx, hy, 0}, {hx, hy + 0.2, h}, wall);
+  w.add_aabb({-hx - 0.2, -hy - 0.2, h}, {hx + 0.2, hy + 0.2, h + 0.2}, wall);  // ceiling
+  // Furniture and posters along the walls, clear of the loop in the middle.
+  const int pieces = 6 + static_cast<int>(rng() % 5);
+  for (int i = 0; i < pieces; ++i) {
+    const int side = static_cast<int>(rng() % 4);
+    const double along = uniform(rng, -0.8, 0.8);
+    const double sx = uniform(rng, 0.4, 1.2), sy = uniform(rng, 0.3, 0.6);
+    const double height = uniform(rng, 0.5, 2.0);
+    Eigen::Vector3d c;
+    double yaw = 0;
+    if (side < 2) {
+      c = {along * (hx - 1.2), (side == 0 ? -1 : 1) * (hy - sy - 0.05), height / 2};
+    } else {
+      c = {(side == 2 ? -1 : 1) * (hx - sy - 0.05), along * (hy - 1.2), height / 2};
+      yaw = kPi / 2;
+    }
+    w.add_yawed(c, {sx, sy, height / 2}, yaw, i % 3 == 0 ? computer : wood);
+    // A poster on the wall behind it.
+    Eigen::Vector3d pc = c;
+    pc.z() = uniform(rng, 1.4, 2.0);
+    if (side < 2)
+      pc.y() = (side == 0 ? -1 : 1) * (hy - 0.01);
+    else
+      pc.x() = (side == 2 ? -1 : 1) * (hx - 0.01);
+    w.add_yawed(pc, {uniform(rng, 0.3, 0.6), 0.01, 0.3}, yaw, poster);
+  }
+  for (double x : {-hx / 2, hx / 2})
+    for (double y : {-hy / 2, hy / 2}) {
+      w.add_aabb({x - 0.3, y - 0.3, h - 0.05}, {x + 0.3, y + 0.3, h}, lamp);
+      w.lights.push_back({{x, y, h - 0.1}, 1.5});
+    }
+  PeriodicSpline2 path(loop_waypoints(rng, 8, hx - 1.7, hy - 1.5, 0.12));
+  s.trajectory = Trajectory(path, make_speed(rng, duration_s, 2.0, 0.3, 0.8, 0.4, 0.15),
+                            make_bumps(rng, 0.002, 0.003, g));
+  return s;
+}
+
+Scenario corridor(std::uint64_t seed, double duration_s, double g) {
+  Rng rng(seed * 0x9E3779B97F4A7C15ull + 2);
+  Scenario s;
+  s.name = "corridor";
+  World& w = s.world;
+  w.ambient = 0.02;
+  w.headlight = 0.6;
+  w.air_temperature_c = 20;
+  w.sky_temperature_c = 20;
+  const auto floor = w.add_material({30, 0.35, kTextureNoise, 0.08, 20, 0, {0.8, 0.85, 0.9}});
+  const auto wall = w.add_material({55, 0.7, kTexturePlain, 0, 20.5, 0, {0.85, 0.95, 1.0}});
+  const auto end_wall = w.add_material({5, 0.1, kTexturePlain, 0, 20, 0, {1, 1, 1}});
+  const auto lamp = w.add_material({70, 0.9, kTexturePlain, 0, 35, 2.0, {0.9, 1, 1}});
+  const auto radiator = w.add_material({40, 0.6, kTextureStripes, 0.3, 45, 0, {1, 1, 1}});
+  add_ground(w, floor);
+  const double half_len = 150, half_w = uniform(rng, 1.4, 1.8), h = 2.8;
+  // Walls and ceiling flush along the axis: nothing on them varies with x for the lidar.
+  w.add_aabb({-half_len, -half_w - 0.3, 0}, {half_len, -half_w, h}, wall);
+  w.add_aabb({-half_len, half_w, 0}, {half_len, half_w + 0.3, h}, wall);
+  w.add_aabb({-half_len, -half_w - 0.3, h}, {half_len, half_w + 0.3, h + 0.3}, wall);
+  w.add_aabb({-half_len - 0.3, -half_w, 0}, {-half_len, half_w, h}, end_wall);
+  w.add_aabb({half_len, -half_w, 0}, {half_len + 0.3, half_w, h}, end_wall);
+  for (double x = -half_len + uniform(rng, 2, 10); x < half_len; x += uniform(rng, 8, 14)) {
+    w.add_aabb({x - 0.3, -0.15, h - 0.02}, {x + 0.3, 0.15, h}, lamp);  // flush ceiling panels
+    w.lights.push_back({{x, 0, h - 0.1}, 0.25});
+  }
+  // Radiators: thin, flush (2 cm) so the lidar barely sees them; the thermal camera does.
+  for (double x = -half_len + uniform(rng, 5, 20); x < half_len; x += uniform(rng, 15, 30)) {
+    const double side = (rng() % 2 == 0) ? -1 : 1;
+    const double y0 = side * half_w;
+    w.add_aabb({x - 0.6, std::min(y0, y0 - side * 0.02), 0.2},
+               {x + 0.6, std::max(y0, y0 - side * 0.02), 0.8}, radiator);
+  }
+  // Down one side, U-turn, back the other: a long thin loop.
+  const double run = uniform(rng, 25, 40), lane = half_w - 0.75, turn = lane;
+  std::vector<Eigen::Vector2d> pts;
+  for (double x = -run; x <= run; x += 10) pts.emplace_back(x, -lane);
+  for (int k = 1; k < 6; ++k) {
+    const double a = -kPi / 2 + kPi * k / 6;
+    pts.emplace_back(run + turn * std::cos(a), turn * std::sin(a));
+  }
+  for (double x = run; x >= -run; x -= 10) pts.emplace_back(x, lane);
+  for (int k = 1; k < 6; ++k) {
+    const double a = kPi / 2 + kPi * k / 6;
+    pts.emplace_back(-run + turn * std::cos(a), turn * std::sin(a));
+  }
+  s.trajectory =
+      Trajectory(PeriodicSpline2(pts), make_speed(rng, duration_s, 2.0, 0.6, 1.4, 0.4, 0.1),
+                 make_bumps(rng, 0.003, 0.004, g));
+  return s;
+}
+
+Scenario mine(std::uint64_t seed, double duration_s, double g) {
+  Rng rng(seed * 0x9E3779B97F4A7C15ull + 3);
+  Scenario s;
+  s.name = "mine";
+  World& w = s.world;
+  w.ambient = 0.003;
+  w.headlight = 1.0;
+  w.air_temperature_c = 17;
+  w.sky_temperature_c = 17;
+  const auto ground = w.add_material({15, 0.2, kTextureNoise, 0.3, 16, 0, {0.6, 0.65, 0.7}});
+  const auto rock = w.add_material({22, 0.25, kTextureNoise, 0.25, 17, 0, {0.6, 0.7, 0.75}});
+  const auto machine = w.add_material({35, 0.35, kTextureStripes, 0.5, 55, 0, {0.2, 0.6, 0.9}});
+  const auto lamp = w.add_material({70, 0.9, kTexturePlain, 0, 60, 2.5, {0.7, 0.9, 1}});
+  add_ground(w, ground);
+  const double R = uniform(rng, 25, 40);
+  PeriodicSpline2 path(loop_waypoints(rng, 10, R, R * uniform(rng, 0.6, 1.0), 0.2));
+  const auto samples = sample_path(path, 0.5);
+  const double half_w = uniform(rng, 1.8, 2.3), h = 3.2;
+  for (double u = 0; u < path.length(); u += 1.0) {
+    const PathFrame f = path_frame(path, u);
+    for (double side : {-1.0, 1.0}) {
+      const double thick = uniform(rng, 0.5, 1.2);
+      const double lateral = half_w + uniform(rng, 0.0, 0.45) + thick;
+      const double yaw = f.yaw + uniform(rng, -0.25, 0.25);
+      const Eigen::Vector2d c = f.p + side * lateral * f.n;
+      const double hh = h + uniform(rng, -0.3, 0.3);
+      if (!clear_of_path(samples, c, 0.7, thick, yaw, half_w - 0.2)) continue;
+      w.add_yawed({c.x(), c.y(), hh / 2}, {0.7, thick, hh / 2}, yaw, rock);
+    }
+    // Roof: a slab across the tunnel, at a rough height.
+    const double roof = h + uniform(rng, -0.25, 0.2);
+    w.add_yawed({f.p.x(), f.p.y(), roof + 0.3}, {0.65, half_w + 1.5, 0.3},
+                f.yaw + uniform(rng, -0.1, 0.1), rock);
+    if (rng() % 40 == 0) {  // a warm machine in a niche
+      const double side = (rng() % 2 == 0) ? -1 : 1;
+      const Eigen::Vector2d c = f.p + side * (half_w - 0.1) * f.n;
+      if (clear_of_path(samples, c, 0.8, 0.4, f.yaw, 1.0))
+        w.add_yawed({c.x(), c.y(), 0.6}, {0.8, 0.4, 0.6}, f.yaw, machine);
+    }
+    if (static_cast<int>(u) % 20 == 0) {
+      w.add_yawed({f.p.x(), f.p.y(), roof - 0.05}, {0.15, 0.15, 0.05}, f.yaw, lamp);
+      w.lights.push_back({{f.p.x(), f.p.y(), roof - 0.2}, 0.3});
+    }
+  }
+  s.trajectory = Trajectory(path, make_speed(rng, duration_s, 2.0, 0.5, 1.5, 0.5, 0.15),
+                            make_bumps(rng, 0.02, 0.02, g));
+  return s;
+}
+
+Scenario street_night(std::uint64_t seed, double duration_s, double g) {
+  Rng rng(seed * 0x9E3779B97F4A7C15ull + 4);
+  Scenario s;
+  s.name = "street_night";
+  World& w = s.world;
+  w.ambient = 0.01;
+  w.headlight = 0.8;
+  w.air_temperature_c = 12;
+  w.sky_temperature_c = -30;
+  w.sky_radiance = 0.02;
+  const auto asphalt = w.add_material({12, 0.12, kTextureNoise, 0.3, 16, 0, {0.8, 0.8, 0.8}});
+  const auto brick = w.add_material({30, 0.35, kTextureBricks, 0.6, 13, 0, {0.4, 0.5, 0.75}});
+  const auto concrete = w.add_material({40, 0.5, kTextureNoise, 0.3, 14, 0, {0.85, 0.85, 0.85}});
+  const auto window = w.add_material({8, 0.3, kTextureChecker, 0.5, 15, 0.4, {0.5, 0.8, 1.0}});
+  const auto pole = w.add_material({35, 0.3, kTexturePlain, 0, 11, 0, {0.5, 0.5, 0.5}});
+  const auto lamp = w.add_material({80, 0.9, kTexturePlain, 0, 70, 4.0, {0.6, 0.85, 1.0}});
+  const auto car_cold = w.add_material({25, 0.4, kTexturePlain, 0, 11, 0, {0.2, 0.2, 0.7}});
+  const auto car_warm = w.add_material({25, 0.4, kTexturePlain, 0, 42, 0, {0.7, 0.3, 0.2}});
+  const auto person = w.add_material({15, 0.3, kTexturePlain, 0, 32, 0, {0.3, 0.4, 0.5}});
+  const auto sign = w.add_material({220, 0.8, kTextureStripes, 0.8, 11, 0, {0.1, 0.8, 1.0}});
+  add_ground(w, asphalt);
+  const double rx = uniform(rng, 45, 70), ry = uniform(rng, 30, 50);
+  PeriodicSpline2 path(loop_waypoints(rng, 12, rx, ry, 0.12));
+  const auto samples = sample_path(path, 1.0);
+  const double road = 4.0;  // half width of the road [m]
+  for (double side : {-1.0, 1.0}) {
+    // Buildings, with gaps, set back from the kerb.
+    for (double u = uniform(rng, 0, 10); u < path.length(); u += uniform(rng, 14, 28)) {
+      const PathFrame f = path_frame(path, u);
+      const double len = uniform(rng, 5, 11), depth = uniform(rng, 4, 8);
+      const double height = uniform(rng, 6, 20);
+      const double lateral = road + uniform(rng, 3, 7) + depth;
+      const Eigen::Vector2d c = f.p + side * lateral * f.n;
+      if (!clear_of_path(samples, c, len, depth, f.yaw, road + 2.5)) continue;
+      w.add_yawed({c.x(), c.y(), height / 2}, {len, depth, height / 2}, f.yaw,
+                  rng() % 2 == 0 ? brick : concrete);
+      // Lit windows on the street side.
+      const Eigen::Vector2d wc = f.p + side * (lateral - depth - 0.02) * f.n;
+      for (double z = 2.5; z < height - 1; z += 3.2)
+        if (rng() % 3 == 0) w.add_yawed({wc.x(), wc.y(), z}, {len * 0.7, 0.03, 0.6}, f.yaw, window);
+    }
+    // Street lights.
+    for (double u = uniform(rng, 0, 20); u < path.length(); u += uniform(rng, 20, 32)) {
+      const PathFrame f = path_frame(path, u);
+      const Eigen::Vector2d c = f.p + side * (road + 0.8) * f.n;
+      if (!clear_of_path(samples, c, 0.1, 0.1, 0, road)) continue;
+      w.add_aabb({c.x() - 0.08, c.y() - 0.08, 0}, {c.x() + 0.08, c.y() + 0.08, 6.0}, pole);
+      const Eigen::Vector2d head = f.p + side * (road - 0.2) * f.n;
+      w.add_yawed({head.x(), head.y(), 6.0}, {0.3, 0.6, 0.08}, f.yaw, lamp);
+      w.lights.push_back({{head.x(), head.y(), 5.8}, 25.0});
+      if (rng() % 3 == 0) w.add_yawed({c.x(), c.y(), 2.5}, {0.02, 0.3, 0.3}, f.yaw + kPi / 2, sign);
+    }
+    // Parked cars along the kerb, some with warm engines; pedestrians on the pavement.
+    for (double u = uniform(rng, 0, 15); u < path.length(); u += uniform(rng, 8, 30)) {
+      const PathFrame f = path_frame(path, u);
+      const Eigen::Vector2d c = f.p + side * (road - 1.0) * f.n;
+      if (!clear_of_path(samples, c, 2.3, 0.9, f.yaw, 1.6)) continue;
+      w.add_yawed({c.x(), c.y(), 0.75}, {2.3, 0.9, 0.75}, f.yaw,
+                  rng() % 3 == 0 ? car_warm : car_cold);
+    }
+    for (double u = uniform(rng, 0, 15); u < path.length(); u += uniform(rng, 15, 40)) {
+      const PathFrame f = path_frame(path, u);
+      const Eigen::Vector2d c = f.p + side * (road + uniform(rng, 1.2, 2.5)) * f.n;
+      if (!clear_of_path(samples, c, 0.25, 0.2, f.yaw, road)) continue;
+      w.add_yawed({c.x(), c.y(), 0.85}, {0.25, 0.2, 0.85}, f.yaw, person);
+    }
+  }
+  s.trajectory = Trajectory(path, make_speed(rng, duration_s, 2.0, 2.0, 6.0, 0.8, 0.12),
+                            make_bumps(rng, 0.008, 0.006, g));
+  return s;
+}
+
+constexpr std::array<std::string_view, 4> kNames = {"street_night", "corridor", "mine", "room"};
+
+}  // namespace
+
+std::span<const std::string_view> scenario_names() { return kNames; }
+
+std::optional<Scenario> make_scenario(std::string_view name, std::uint64_t seed, double duration_s,
+                                      double gravity_mps2, std::string& error) {
+  if (name == "room") return room(seed, duration_s, gravity_mps2);
+  if (name == "corridor") return corridor(seed, duration_s, gravity_mps2);
+  if (name == "mine") return mine(seed, duration_s, gravity_mps2);
+  if (name == "street_night") return street_night(seed, duration_s, gravity_mps2);
+  error = "unknown scenario '" + std::string(name) + "' (street_night, corridor, mine, room)";
+  return std::nullopt;
+}
+
+}  // namespace posed::sim

@@ -1,0 +1,38 @@
+#pragma once
+// The named worlds and drives (docs/simulator.md says what each one stresses). A scenario is a
+// pure function of (name, seed, duration): the same inputs give the same world and trajectory,
+// another seed gives another world and drive of the same kind.
+//
+//   room          small, well lit, furnished room; slow loop (sanity check)
+//   corridor      long, plain corridor with dim lights: lidar scan matching is degenerate along
+//                 its axis, the camera sees little texture
+//   mine          rough, dark tunnel loop, rocky walls, a few warm machines, headlight only
+//   street_night  large loop between buildings at night: street lights, parked cars (some warm),
+//                 pedestrians, a cold sky
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "tools/sim/trajectory.hpp"
+#include "tools/sim/world.hpp"
+
+namespace posed::sim {
+
+struct Scenario {
+  std::string name;
+  World world;
+  Trajectory trajectory;
+};
+
+/// The known scenario names, in documentation order.
+std::span<const std::string_view> scenario_names();
+
+/// Builds scenario `name` for `seed`, with a speed profile covering `duration_s` (plus margin).
+/// nullopt + `error` for an unknown name.
+std::optional<Scenario> make_scenario(std::string_view name, std::uint64_t seed, double duration_s,
+                                      double gravity_mps2, std::string& error);
+
+}  // namespace posed::sim
