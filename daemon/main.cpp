@@ -34,6 +34,10 @@ int main(int argc, char** argv) noexcept try {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--record", options.record_path,
                  "record every sensor's raw bytes and the poses to this MCAP file");
+  app.add_option("--save-map", options.map_path,
+                 "at the end of the run (or on SIGTERM), write the lidar map to this PCD file "
+                 "(binary, x y z in the map frame [m]) and the keyframe poses to "
+                 "FILE.keyframes.tum");
   auto* replay = app.add_option("--replay", options.replay.path,
                                 "replay this MCAP recording through the same pipeline instead of "
                                 "opening the sensors")

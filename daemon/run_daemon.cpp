@@ -22,6 +22,7 @@
 #include "daemon/pipeline/source_factory.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
+#include "drivers/recording/map_files.hpp"
 #include "drivers/recording/recorder.hpp"
 
 namespace posed {
@@ -63,7 +64,47 @@ std::string read_text_file(const std::string& path) {
   return text.str();
 }
 
+/// Writes the map and keyframes the fusion core kept; false (logged) when there is none or a
+/// file cannot be written. `line` gets the summary line.
+bool save_map(const pipeline::Pipeline& pipe, const std::string& map_path, HostToWall to_wall,
+              std::string& line) {
+  MapExport map;
+  pipe.export_map(map);
+  if (map.keyframes.empty()) {
+    POSED_LOG_ERROR("--save-map %s: no map was built (%s)", map_path.c_str(),
+                    "no lidar scan was matched; a map needs the lidar-inertial estimator");
+    line = "none (no lidar scan was matched)";
+    return false;
+  }
+  std::string error;
+  std::vector<drivers::recording::StampedTransform> keyframes;
+  keyframes.reserve(map.keyframes.size());
+  for (const auto& k : map.keyframes) keyframes.push_back({to_wall(k.stamp), k.T_map_base});
+  const std::string keyframes_path = keyframes_path_for(map_path);
+  if (!drivers::recording::write_pcd(map_path, map.points_map_m, error) ||
+      !drivers::recording::write_tum(keyframes_path, keyframes, error)) {
+    POSED_LOG_ERROR("--save-map: %s", error.c_str());
+    line = "failed: " + error;
+    return false;
+  }
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%zu points (%.2f m voxels) to %s, %zu keyframes to %s",
+                map.points_map_m.size(), map.voxel_m, map_path.c_str(), keyframes.size(),
+                keyframes_path.c_str());
+  line = buf;
+  return true;
+}
+
 }  // namespace
+
+std::string keyframes_path_for(const std::string& map_path) {
+  const std::string ext = ".pcd";
+  if (map_path.size() > ext.size() &&
+      map_path.compare(map_path.size() - ext.size(), ext.size(), ext) == 0) {
+    return map_path.substr(0, map_path.size() - ext.size()) + ".keyframes.tum";
+  }
+  return map_path + ".keyframes.tum";
+}
 
 int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   // Signals are taken synchronously by this thread; the stage threads inherit the mask.
@@ -84,8 +125,9 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   dds_config.base_frame = config.dds.base_frame;
   dds_config.cyclonedds_xml_path = config.dds.cyclonedds_config;
   std::string error;
-  std::unique_ptr<dds::Publisher> publisher = dds::Publisher::create(dds_config, error);
-  if (!publisher) {
+  std::unique_ptr<dds::Publisher> publisher;
+  if (options.publish_dds) publisher = dds::Publisher::create(dds_config, error);
+  if (options.publish_dds && !publisher) {
     POSED_LOG_ERROR("cannot start DDS: %s", error.c_str());
     return 1;
   }
@@ -141,6 +183,7 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   const Duration pose_period = Duration::from_seconds(1.0 / config.publish.pose_rate_hz);
   std::uint64_t state_index = 0;
   pipeline::PipelineOutputs outputs;
+  outputs.keep_map = !options.map_path.empty();
   outputs.on_state = [&](const NavState& s) {
     const WallTime stamp = to_wall(s.stamp);
     // Optimised states (one per scan) go on rt/posed/pose; IMU propagation on rt/posed/odom. An
@@ -159,7 +202,9 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
         odom.w_base_radps = s.w_base_radps;
         odom.pose_covariance = to_row_major(s.pose_covariance);
         odom.twist_covariance = to_row_major(s.twist_covariance);
-        if (publisher->publish_odom(odom))
+        if (!publisher) {
+          // offline run: nothing to publish
+        } else if (publisher->publish_odom(odom))
           ++tally.odom;
         else
           ++tally.failed;
@@ -173,7 +218,9 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
       pose.stamp = stamp;
       pose.p_map_base_m = s.p_map_base_m;
       pose.q_map_base = s.q_map_base;
-      if (publisher->publish_pose(pose))
+      if (!publisher) {
+        // offline run: nothing to publish
+      } else if (publisher->publish_pose(pose))
         ++tally.pose;
       else
         ++tally.failed;
@@ -224,7 +271,9 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
                   static_cast<unsigned long long>(tally.odom));
     line += odom_part;
     msg.summary = line;
-    if (publisher->publish_status(msg))
+    if (!publisher) {
+      // offline run: nothing to publish
+    } else if (publisher->publish_status(msg))
       ++tally.status;
     else
       ++tally.failed;
@@ -239,7 +288,7 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   const double wait_s = options.wait_subscribers_s >= 0 ? options.wait_subscribers_s
                         : replaying                     ? 1.0
                                                         : 0.0;
-  if (wait_s > 0) {
+  if (publisher && wait_s > 0) {
     const HostTime give_up = drivers::host_now() + Duration::from_seconds(wait_s);
     while (publisher->matched_subscribers(dds::Topic::kOdom) == 0 &&
            publisher->matched_subscribers(dds::Topic::kPose) == 0 &&
@@ -322,6 +371,9 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());
     exit_code = 1;
   }
+  std::string map_line;
+  if (!options.map_path.empty() && !save_map(pipe, options.map_path, to_wall, map_line))
+    exit_code = 1;
 
   // The summary a person reads at the end of a run.
   const pipeline::PipelineStatus st = pipe.status();
@@ -375,11 +427,14 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
                 f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
                 f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());
   }
-  std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
-              static_cast<unsigned long long>(tally.odom),
-              static_cast<unsigned long long>(tally.pose),
-              static_cast<unsigned long long>(tally.status), config.dds.domain_id,
-              tally.failed ? " (some writes failed)" : "");
+  if (!publisher)
+    std::printf("  published           nothing (offline run, no DDS)\n");
+  else
+    std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
+                static_cast<unsigned long long>(tally.odom),
+                static_cast<unsigned long long>(tally.pose),
+                static_cast<unsigned long long>(tally.status), config.dds.domain_id,
+                tally.failed ? " (some writes failed)" : "");
   if (recorder) {
     const auto rc = recorder->counters();
     std::printf("  recorded            %llu messages to %s (%.1f MB, %llu dropped)\n",
@@ -387,6 +442,7 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
                 static_cast<double>(rc.bytes_on_disk) / 1e6,
                 static_cast<unsigned long long>(rc.dropped));
   }
+  if (!map_line.empty()) std::printf("  map                 %s\n", map_line.c_str());
   if (tally.last) {
     const NavState& s = *tally.last;
     std::printf("  final pose          x %.3f m, y %.3f m, z %.3f m, yaw %.1f deg\n",

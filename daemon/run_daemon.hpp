@@ -16,12 +16,20 @@ struct RunOptions {
   double duration_s = 0;
   /// record every Source's raw bytes, and the poses, to this MCAP file; empty = no recording
   std::string record_path;
+  /// at the end of the run, write the lidar map here (PCD) and the keyframe poses next to it
+  /// (keyframes_path_for()); empty = keep no map
+  std::string map_path;
   /// replay this recording instead of opening the sensors (replay.path empty = live)
   pipeline::ReplayOptions replay;
   /// before the first sample, wait up to this long for a DDS reader of odom or pose to match;
   /// negative: 1 s when replaying (a fast replay could end before discovery), 0 live [s]
   double wait_subscribers_s = -1;
+  /// false: join no DDS domain and publish nothing (offline jobs such as posectl export --pcd)
+  bool publish_dds = true;
 };
+
+/// Where the keyframe poses of a map saved to `map_path` go: MAP.pcd -> MAP.keyframes.tum.
+std::string keyframes_path_for(const std::string& map_path);
 
 /// Returns the process exit code.
 int run_daemon(const config::PosedConfig& config, const RunOptions& options);

@@ -31,6 +31,17 @@ struct FusionFigures {
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]
 };
 
+/// The map an estimator built over a run, for export at its end (posed --save-map).
+struct MapExport {
+  struct Keyframe {
+    HostTime stamp;                ///< the keyframe scan's end
+    Eigen::Isometry3d T_map_base;  ///< base_link (IMU frame) in the map frame
+  };
+  std::vector<Eigen::Vector3f> points_map_m;  ///< map frame [m]
+  double voxel_m = 0;                         ///< resolution the points were merged at [m]
+  std::vector<Keyframe> keyframes;
+};
+
 class FusionCore {
  public:
   virtual ~FusionCore() = default;
@@ -42,6 +53,9 @@ class FusionCore {
   /// one line for the summary and logs, e.g. "strapdown (IMU-only dead reckoning ...)"
   virtual std::string_view description() const = 0;
   virtual FusionFigures figures() const = 0;
+  /// Appends the map and keyframe poses built so far; cores without a map (IMU-only) add
+  /// nothing, and so does a core not asked to keep one (LioConfig::keep_map).
+  virtual void export_map(MapExport& out) const { (void)out; }
 };
 
 /// IMU-only dead reckoning (Strapdown): the core for configurations without aiding sensors.

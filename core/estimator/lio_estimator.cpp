@@ -33,6 +33,7 @@ LioEstimator::LioEstimator(const LioConfig& config)
       imu_(ImuBufferConfig{.capacity = 4000}),
       gate_(MeasurementGateConfig{.pending_capacity = 8}),
       lidar_(config.lidar),
+      map_cloud_(config.map_voxel_m),
       window_(window_config(config)) {
   bundle_imu_.reserve(imu_.capacity());
   scratch_.reserve(imu_.capacity());
@@ -389,7 +390,10 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     const Eigen::Isometry3d T_map_lidar = pose_of(estimate) * config_.T_imu_lidar;
     matched_[0] = matched_[1];
     matched_[1] = {t, T_map_lidar};
-    lidar_.commit(T_map_lidar);
+    if (lidar_.commit(T_map_lidar) && config_.keep_map) {
+      map_cloud_.add(lidar_.deskewed(), T_map_lidar);
+      map_keyframes_.push_back({t, pose_of(estimate)});
+    }
   }
   anchor_cov_ = window_.size() > 1 ? window_.latest_pose_covariance()
                                    : Eigen::Matrix<double, 6, 6>::Identity() * 1e-6;
@@ -401,6 +405,13 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
                             anchor_cov_);
   s.sequence = ++sequence_;
   states.push_back(s);
+}
+
+void LioEstimator::export_map(MapExport& out) const {
+  if (!config_.keep_map) return;
+  map_cloud_.collect(out.points_map_m);
+  out.voxel_m = map_cloud_.voxel_m();
+  out.keyframes.insert(out.keyframes.end(), map_keyframes_.begin(), map_keyframes_.end());
 }
 
 }  // namespace posed::estimator

@@ -29,6 +29,7 @@
 #include "core/imu/preintegration.hpp"
 #include "core/imu/static_alignment.hpp"
 #include "core/lidar/lidar_odometry.hpp"
+#include "core/lidar/map_cloud.hpp"
 #include "core/sync/imu_buffer.hpp"
 #include "core/sync/measurement_gate.hpp"
 
@@ -51,6 +52,10 @@ struct LioConfig {
   /// a scan match this far from the IMU prediction is refused rather than believed [m]
   double max_match_jump_m = 1.0;
   double max_match_jump_rad = 0.2;  ///< [rad]
+  /// keep every keyframe's points in a whole-run map for export_map(); off on a robot that
+  /// never exports, since it grows with the area explored
+  bool keep_map = false;
+  double map_voxel_m = 0.1;  ///< resolution of that map [m]
 };
 
 /// The steps of one scan, for profilers (`posectl bench lio`): the estimator calls the probe at
@@ -87,6 +92,7 @@ class LioEstimator final : public FusionCore {
            "window)";
   }
   FusionFigures figures() const override;
+  void export_map(MapExport& out) const override;
 
   const lidar::LidarOdometry& lidar_odometry() const { return lidar_; }
   const SlidingWindow& window() const { return window_; }
@@ -131,6 +137,8 @@ class LioEstimator final : public FusionCore {
   std::vector<ImuSample> bundle_imu_;
   std::vector<ImuSample> scratch_;
   lidar::LidarOdometry lidar_;
+  lidar::MapCloud map_cloud_;  ///< whole-run map, only when config_.keep_map
+  std::vector<MapExport::Keyframe> map_keyframes_;
   lidar::ScanMotion motion_;
   SlidingWindow window_;
   /// the state published poses are propagated from (the newest optimised one)

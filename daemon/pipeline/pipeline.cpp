@@ -23,8 +23,13 @@ std::chrono::nanoseconds block_timeout(const drivers::Source* source) {
 }
 
 /// Lidar-inertial odometry when there is a lidar; IMU-only dead reckoning otherwise.
-std::unique_ptr<FusionCore> make_core(const config::PosedConfig& c, bool have_lidar) {
-  if (have_lidar) return std::make_unique<estimator::LioEstimator>(lio_config(c));
+std::unique_ptr<FusionCore> make_core(const config::PosedConfig& c, bool have_lidar,
+                                      bool keep_map) {
+  if (have_lidar) {
+    estimator::LioConfig lio = lio_config(c);
+    lio.keep_map = keep_map;
+    return std::make_unique<estimator::LioEstimator>(lio);
+  }
   return make_strapdown_core(strapdown_config(c));
 }
 
@@ -103,7 +108,7 @@ bool Pipeline::start(std::string& error) {
   // Recordings and generators at full speed: merge by stamp so replays are deterministic.
   const bool in_stamp_order = !sources_.imu->live() && (!sources_.lidar || !sources_.lidar->live());
   fusion_stage_ = std::make_unique<FusionStage>(
-      config_, make_core(config_, sources_.lidar != nullptr),
+      config_, make_core(config_, sources_.lidar != nullptr, outputs_.keep_map),
       FusionInputs{&imu_queue_, scan_queue_.get()}, in_stamp_order, state_queue_, fusion_ready_,
       state_ready_, *heartbeats_[stage++], *fusion_counters_);
   publisher_stage_ = std::make_unique<PublisherStage>(
@@ -142,6 +147,10 @@ void Pipeline::join() {
     if (t.joinable()) t.join();
   }
   threads_.clear();
+}
+
+void Pipeline::export_map(MapExport& out) const {
+  if (fusion_stage_) fusion_stage_->core().export_map(out);
 }
 
 std::string Pipeline::estimator_description() const {

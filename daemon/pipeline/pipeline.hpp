@@ -49,6 +49,8 @@ struct PipelineOutputs {
   std::function<void(const NavState&)> on_state;
   /// at publish.status_rate_hz, and once more at the end of the stream
   std::function<void(const PipelineStatus&)> on_status;
+  /// keep a whole-run map for export_map() (posed --save-map); costs memory as the area grows
+  bool keep_map = false;
 };
 
 /// One stage's last sign of life, for the systemd watchdog.
@@ -82,6 +84,8 @@ class Pipeline {
   PipelineStatus status() const;
   /// The fusion core's one-line description (valid after start()).
   std::string estimator_description() const;
+  /// The fusion core's map and keyframes (call after join(); empty without a lidar or keep_map).
+  void export_map(MapExport& out) const;
 
  private:
   Heartbeat& add_stage(std::string name);

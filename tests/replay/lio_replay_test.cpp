@@ -8,7 +8,10 @@
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <cstring>
+#include <fstream>
 #include <map>
+#include <sstream>
 
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
@@ -108,6 +111,98 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
   const double ate = std::sqrt(sq / static_cast<double>(pairs.size()));
   // Measured 1-2 cm on such runs; 10 cm is the bound for a 300 s run.
   EXPECT_LT(ate, 0.10) << "ATE " << ate << " m over " << pairs.size() << " poses";
+}
+
+/// A whole file's bytes.
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(LioReplay, PosectlExportPcdWritesTheMapAndItsKeyframesDeterministically) {
+  TempDir dir;
+  const std::string recording = dir.file("street.mcap");
+  const std::string posectl = build_dir() + "/tools/posectl/posectl";
+  {
+    PosedProcess sim({posectl, "sim", "--scenario", "street_night", "--duration", "12", "--seed",
+                      "9", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
+                      recording, "--gt", dir.file("truth.txt")},
+                     {}, dir);
+    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+  }
+  for (const char* name : {"a.pcd", "b.pcd"}) {
+    PosedProcess exporter({posectl, "export", recording, "--pcd", dir.file(name), "--config",
+                           source_dir() + "/config/posed.yaml"},
+                          {}, dir);
+    ASSERT_EQ(exporter.wait_for_exit(120s), 0) << exporter.err() << exporter.out();
+    EXPECT_NE(exporter.out().find("published           nothing (offline run, no DDS)"),
+              std::string::npos)
+        << exporter.out();
+  }
+  const std::string a = slurp(dir.file("a.pcd"));
+  EXPECT_EQ(a, slurp(dir.file("b.pcd"))) << "two exports of one recording differ";
+  EXPECT_EQ(slurp(dir.file("a.keyframes.tum")), slurp(dir.file("b.keyframes.tum")));
+
+  // PCD v0.7: an ASCII header ending in DATA binary, then POINTS x (3 float32).
+  const std::size_t data = a.find("DATA binary\n");
+  ASSERT_NE(data, std::string::npos) << a.substr(0, 300);
+  std::istringstream header(a.substr(0, data));
+  std::string line;
+  std::size_t points = 0;
+  while (std::getline(header, line)) {
+    if (line.rfind("POINTS ", 0) == 0) points = std::stoul(line.substr(7));
+  }
+  const std::string body = a.substr(data + std::strlen("DATA binary\n"));
+  ASSERT_EQ(body.size(), points * 12) << "binary body does not hold POINTS x y z float32";
+  EXPECT_GT(points, 20'000u) << "a 12 s street drive maps more than that";
+  // Every point lies within the lidar's reach of the driven path: nothing is garbage.
+  std::vector<float> xyz(points * 3);
+  std::memcpy(xyz.data(), body.data(), body.size());
+
+  // Keyframes: increasing stamps, at least a metre or a turn apart, along the true path's length.
+  std::ifstream kf(dir.file("a.keyframes.tum"));
+  std::vector<std::pair<double, Eigen::Vector3d>> keyframes;
+  while (std::getline(kf, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream f(line);
+    double t, x, y, z;
+    f >> t >> x >> y >> z;
+    ASSERT_TRUE(f) << line;
+    keyframes.emplace_back(t, Eigen::Vector3d(x, y, z));
+  }
+  ASSERT_GT(keyframes.size(), 5u);
+  double mapped_length = 0;
+  for (std::size_t i = 1; i < keyframes.size(); ++i) {
+    EXPECT_GT(keyframes[i].first, keyframes[i - 1].first);
+    mapped_length += (keyframes[i].second - keyframes[i - 1].second).norm();
+  }
+  for (std::size_t i = 0; i < points; ++i) {
+    const Eigen::Vector3d p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    double nearest = 1e9;
+    for (const auto& k : keyframes) nearest = std::min(nearest, (p - k.second).norm());
+    ASSERT_LT(nearest, 120.0) << "map point " << p.transpose() << " beyond the VLP-32C's reach";
+  }
+  std::ifstream gt(dir.file("truth.txt"));
+  std::vector<std::pair<double, Eigen::Vector3d>> truth;
+  while (std::getline(gt, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream f(line);
+    double t, x, y, z;
+    f >> t >> x >> y >> z;
+    truth.emplace_back(t, Eigen::Vector3d(x, y, z));
+  }
+  ASSERT_GT(truth.size(), 100u);
+  double true_length = 0;
+  for (std::size_t i = 1; i < truth.size(); ++i) {
+    if (truth[i].first < keyframes.front().first || truth[i].first > keyframes.back().first) {
+      continue;
+    }
+    true_length += (truth[i].second - truth[i - 1].second).norm();
+  }
+  ASSERT_GT(true_length, 10.0);
+  // Keyframes cut corners of the true path (chords), so a little shorter, never longer.
+  EXPECT_NEAR(mapped_length, true_length, 0.08 * true_length)
+      << "mapped " << mapped_length << " m vs driven " << true_length << " m";
 }
 
 }  // namespace lio_replay_test

@@ -1,12 +1,18 @@
 // posectl export FILE.mcap --tum OUT.txt: writes a pose channel (geometry_msgs/msg/PoseStamped
 // or nav_msgs/msg/Odometry in CDR) as a TUM trajectory: one line per pose,
 // `timestamp tx ty tz qx qy qz qw` with the header stamp in seconds [s] and positions in [m].
+// posectl export FILE.mcap --pcd MAP.pcd: replays the recording's raw sensor channels through
+// posed's own pipeline at full speed (deterministic, no DDS) and writes the lidar map and its
+// keyframe poses (daemon/run_daemon.hpp, --save-map).
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "daemon/config/config_loader.hpp"
+#include "daemon/run_daemon.hpp"
+#include "drivers/recording/map_files.hpp"
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
 #include "tools/posectl/commands.hpp"
@@ -15,16 +21,58 @@ namespace posed::posectl {
 
 namespace rec = drivers::recording;
 
+namespace {
+
+/// Replays `path` through the daemon's pipeline without DDS and saves the map.
+int export_map(const std::string& path, const std::string& config_path,
+               const std::string& pcd_path) {
+  config::LoadResult loaded =
+      config_path.empty() ? config::LoadResult{} : config::load_config_file(config_path);
+  if (config_path.empty()) loaded.config = config::default_config();
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "posectl export: invalid configuration:\n%s", loaded.error_text().c_str());
+    return 2;
+  }
+  RunOptions options;
+  options.replay.path = path;
+  options.replay.rate = 0;  // max speed: lossless and deterministic
+  options.map_path = pcd_path;
+  options.publish_dds = false;
+  std::fprintf(stderr,
+               "posectl export: replaying %s through posed's pipeline to build the map...\n",
+               path.c_str());
+  return run_daemon(loaded.config, options);
+}
+
+}  // namespace
+
 int run_export(int argc, char** argv) {
   CLI::App app{
-      "Exports poses from an MCAP recording. --tum writes a TUM trajectory (timestamp [s], "
-      "position [m],\nquaternion x y z w) from a PoseStamped or Odometry channel.",
+      "Exports from an MCAP recording.\n  --tum: a TUM trajectory (timestamp [s], position [m], "
+      "quaternion x y z w) from a PoseStamped\n         or Odometry channel in the file.\n"
+      "  --pcd: the lidar map, built by replaying the raw lidar and IMU channels through posed's\n"
+      "         pipeline at full speed (no DDS): a binary PCD (x y z [m], map frame) and the\n"
+      "         keyframe poses next to it (MAP.keyframes.tum).",
       "posectl export"};
-  std::string path, tum_path, topic;
-  app.add_option("FILE", path, "MCAP recording")->required();
-  app.add_option("--tum", tum_path, "TUM trajectory to write")->required();
-  app.add_option("--topic", topic, "pose channel (needed when the file has more than one)");
+  std::string path, tum_path, pcd_path, topic, config_path;
+  app.add_option("FILE", path, "MCAP recording")->required()->check(CLI::ExistingFile);
+  app.add_option("--tum", tum_path, "TUM trajectory to write");
+  app.add_option("--topic", topic, "pose channel for --tum (needed when the file has several)");
+  app.add_option("--pcd", pcd_path, "map to write (PCD)");
+  app.add_option("-c,--config", config_path,
+                 "posed configuration for --pcd (rig, estimator); default: the built-in defaults, "
+                 "the rig of config/posed.yaml")
+      ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
+  if (tum_path.empty() && pcd_path.empty()) {
+    std::fprintf(stderr,
+                 "posectl export: nothing to do: give --tum OUT.txt and/or --pcd MAP.pcd\n");
+    return 2;
+  }
+  if (!pcd_path.empty()) {
+    const int rc = export_map(path, config_path, pcd_path);
+    if (rc != 0 || tum_path.empty()) return rc;
+  }
 
   rec::McapReader reader;
   std::string error;
@@ -78,10 +126,10 @@ int run_export(int argc, char** argv) {
       ++undecodable;
       continue;
     }
-    std::fprintf(out, "%lld.%09lld %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
-                 static_cast<long long>(p.stamp.ns / 1'000'000'000),
-                 static_cast<long long>(p.stamp.ns % 1'000'000'000), p.p_xyz_m[0], p.p_xyz_m[1],
-                 p.p_xyz_m[2], p.q_xyzw[0], p.q_xyzw[1], p.q_xyzw[2], p.q_xyzw[3]);
+    const std::string line =
+        rec::tum_line(p.stamp.ns, Eigen::Vector3d(p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]),
+                      Eigen::Quaterniond(p.q_xyzw[3], p.q_xyzw[0], p.q_xyzw[1], p.q_xyzw[2]));
+    std::fputs(line.c_str(), out);
     ++written;
   }
   const bool write_ok = std::fclose(out) == 0;

@@ -16,7 +16,7 @@ std::span<const Command> commands() {
       Command{"sim",
               "simulate the rig in a scenario: a recording with raw sensor data and ground truth",
               run_sim},
-      Command{"export", "write poses of an MCAP recording as a TUM trajectory", run_export},
+      Command{"export", "write an MCAP recording's poses (TUM) or its lidar map (PCD)", run_export},
   };
   return kCommands;
 }

@@ -20,8 +20,8 @@ int run_inspect(int argc, char** argv);
 int run_inspect_velodyne(int argc, char** argv);
 int run_echo(int argc, char** argv);
 int run_eval(int argc, char** argv);
-int run_sim(int argc, char** argv);           // sim helper
-int run_inspect_mcap(int argc, char** argv);  // mcap helper
-int run_export(int argc, char** argv);        // mcap helper
+int run_sim(int argc, char** argv);
+int run_inspect_mcap(int argc, char** argv);
+int run_export(int argc, char** argv);
 
 }  // namespace posed::posectl
