@@ -313,14 +313,18 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   }
   notify::WatchdogPinger pinger(notifier.watchdog_interval());
   notifier.notify("READY=1\nSTATUS=sources open, aligning");
+  char dds_part[128] = "offline, no DDS";
+  if (publisher) {
+    std::snprintf(dds_part, sizeof dds_part,
+                  "on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
+                  config.dds.domain_id);
+  }
   if (replaying) {
-    POSED_LOG_INFO(
-        "replaying %s (%s) on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
-        options.replay.path.c_str(), replay_streams.c_str(), config.dds.domain_id);
+    POSED_LOG_INFO("replaying %s (%s) %s", options.replay.path.c_str(), replay_streams.c_str(),
+                   dds_part);
   } else {
-    POSED_LOG_INFO(
-        "running: imu %s%s on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
-        config.imu.source.c_str(), config.lidar.enabled ? ", lidar" : "", config.dds.domain_id);
+    POSED_LOG_INFO("running: imu %s%s %s", config.imu.source.c_str(),
+                   config.lidar.enabled ? ", lidar" : "", dds_part);
   }
 
   int exit_code = 0;
