@@ -3,6 +3,7 @@
 #include <charconv>
 #include <set>
 
+#include "drivers/common/log.hpp"
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/mcap_replay_source.hpp"
 #include "drivers/recording/raw_channels.hpp"
@@ -57,11 +58,20 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
-  // Cameras replay when recorded; a recording of other streams (a depth camera, a second IMU)
-  // is listed but has no stage to go to.
+  // Cameras replay when recorded; other streams (the D435i's depth, a second IMU) have no stage
+  // to go to: they are listed, said once, and never read.
   if (streams.count("visible")) out.built.sources.visible = make("visible");
   if (streams.count("thermal")) out.built.sources.thermal = make("thermal");
-  for (const auto& s : streams) out.streams += (out.streams.empty() ? "" : ", ") + s;
+  std::string skipped;
+  for (const auto& s : streams) {
+    out.streams += (out.streams.empty() ? "" : ", ") + s;
+    if (s != "imu" && s != "lidar" && s != "visible" && s != "thermal")
+      skipped += (skipped.empty() ? "" : ", ") + s;
+  }
+  if (!skipped.empty()) {
+    POSED_LOG_NOTICE("%s: no pipeline stage for stream(s) %s: not replayed", options.path.c_str(),
+                     skipped.c_str());
+  }
   return out;
 }
 
