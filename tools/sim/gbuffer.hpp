@@ -9,6 +9,7 @@
 // everything else is exact per pixel, including the lens distortion of the intrinsics.
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -25,6 +26,18 @@ struct CameraIntrinsics {
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;                      ///< [-]
 };
 
+/// Rays are cast on every kGridStep-th pixel; the cells between them are filled per pixel.
+inline constexpr int kGridStep = 4;
+/// Grid points along an image side of `pixels` (the last pixel always included).
+inline int grid_points(int pixels) { return (pixels - 1 + kGridStep - 1) / kGridStep + 1; }
+/// The pixel of grid point `i` along a side of `pixels`.
+inline int grid_pixel(int i, int pixels) { return std::min(i * kGridStep, pixels - 1); }
+/// One past the last pixel of cell `i` (between grid points i and i + 1) of `points` points:
+/// cells own their first row/column; the last cell also its last.
+inline int cell_end(int i, int points, int pixels) {
+  return i + 2 == points ? grid_pixel(i + 1, pixels) + 1 : grid_pixel(i + 1, pixels);
+}
+
 /// Per-pixel hits of one view.
 struct GBuffer {
   int width = 0, height = 0;
@@ -34,6 +47,14 @@ struct GBuffer {
   std::vector<std::uint8_t> face;
   /// distance along the ray [m]
   std::vector<float> t_m;
+  /// the grid rays' hits, row-major over grid_points(width) x grid_points(height)
+  std::vector<std::int32_t> grid_box;
+  std::vector<std::uint8_t> grid_face;
+  /// cells between grid points (cells_x = grid_points(width) - 1, ...)
+  int cells_x = 0, cells_y = 0;
+  /// per cell, row-major: its four corners saw the same face, so every pixel in it lies on
+  /// that face's plane (smooth shading can be interpolated across it)
+  std::vector<std::uint8_t> plane_cell;
 };
 
 /// Unit ray directions of every pixel in the camera frame (x right, y down, z forward),

@@ -31,6 +31,19 @@ ThermalCamera::ThermalCamera(const ThermalCameraConfig& config, const SensorScen
   for (float& v : fpn_col_) v = static_cast<float>(n(rng_));
   std::uniform_real_distribution<double> u(config_.nuc_min_s, config_.nuc_max_s);
   next_nuc_s_ = u(rng_);
+  // Full-resolution pixel centres in the half-resolution render, clamped at the borders.
+  const auto taps = [](std::size_t full, int half) {
+    std::vector<Tap> out(full);
+    for (std::size_t i = 0; i < full; ++i) {
+      const double s = std::clamp((static_cast<double>(i) - 0.5) / 2.0, 0.0, half - 1.0);
+      out[i].i0 = static_cast<std::size_t>(s);
+      out[i].i1 = std::min(out[i].i0 + 1, static_cast<std::size_t>(half - 1));
+      out[i].f = static_cast<float>(s - static_cast<double>(out[i].i0));
+    }
+    return out;
+  };
+  row_taps_ = taps(H, rays_.height());
+  col_taps_ = taps(W, rays_.width());
 }
 
 Duration ThermalCamera::next_send() const { return schedule_.true_time(index_); }
@@ -88,7 +101,7 @@ void ThermalCamera::emit(std::vector<std::byte>& out) {
     for (float& v : fpn_col_) v = static_cast<float>(n(rng_));
   }
   render_temperatures(t);
-  const int w = gbuffer_.width, h = gbuffer_.height;
+  const int w = gbuffer_.width;
 
   // y8: the camera's AGC over the frame's range, smoothed over frames, at least 4 K wide.
   double k = 0;
@@ -111,31 +124,31 @@ void ThermalCamera::emit(std::vector<std::byte>& out) {
   }
 
   out.resize(W * H * (raw16 ? 2 : 1));
-  const double fpn = config_.noise ? config_.fpn_growth_kps * (t_s - last_nuc_s_) + 0.03 : 0.0;
+  const auto fpn =
+      static_cast<float>(config_.noise ? config_.fpn_growth_kps * (t_s - last_nuc_s_) + 0.03 : 0.0);
+  const auto netd = static_cast<float>(config_.netd_k);
+  const auto lo = static_cast<float>(agc_lo_c_), gain = static_cast<float>(k);
+  std::vector<float> row(W);
   for (std::size_t y = 0; y < H; ++y) {
-    // Bilinear upsampling from the half-resolution render.
-    const double sy = std::clamp((static_cast<double>(y) - 0.5) / 2.0, 0.0, h - 1.0);
-    const auto y0 = static_cast<std::size_t>(sy);
-    const std::size_t y1 = std::min(y0 + 1, static_cast<std::size_t>(h - 1));
-    const double fy = sy - static_cast<double>(y0);
+    // Bilinear upsampling from the half-resolution render: rows, then columns by table.
+    const Tap& ty = row_taps_[y];
+    const float* t0 = &temperature_[ty.i0 * static_cast<std::size_t>(w)];
+    const float* t1 = &temperature_[ty.i1 * static_cast<std::size_t>(w)];
+    for (std::size_t c = 0; c < static_cast<std::size_t>(w); ++c)
+      row[c] = t0[c] + ty.f * (t1[c] - t0[c]);
     for (std::size_t x = 0; x < W; ++x) {
-      const double sx = std::clamp((static_cast<double>(x) - 0.5) / 2.0, 0.0, w - 1.0);
-      const auto x0 = static_cast<std::size_t>(sx);
-      const std::size_t x1 = std::min(x0 + 1, static_cast<std::size_t>(w - 1));
-      const double fx = sx - static_cast<double>(x0);
-      const auto row0 = y0 * static_cast<std::size_t>(w), row1 = y1 * static_cast<std::size_t>(w);
-      double T = (temperature_[row0 + x0] * (1 - fx) + temperature_[row0 + x1] * fx) * (1 - fy) +
-                 (temperature_[row1 + x0] * (1 - fx) + temperature_[row1 + x1] * fx) * fy;
+      const Tap& tx = col_taps_[x];
+      float T = row[tx.i0] + tx.f * (row[tx.i1] - row[tx.i0]);
       if (config_.noise) {
-        T += config_.netd_k * noise_.normal() + fpn * (fpn_pixel_[y * W + x] + 0.7 * fpn_col_[x]);
+        T += netd * noise_.normal() + fpn * (fpn_pixel_[y * W + x] + 0.7f * fpn_col_[x]);
       }
       const std::size_t i = y * W + x;
       if (raw16) {
-        const std::uint16_t c = radiometry_.counts_u14(static_cast<float>(T));
-        out[2 * i] = static_cast<std::byte>(c & 0xFF);
-        out[2 * i + 1] = static_cast<std::byte>(c >> 8);
+        const std::uint16_t counts = radiometry_.counts_u14(T);
+        out[2 * i] = static_cast<std::byte>(counts & 0xFF);
+        out[2 * i + 1] = static_cast<std::byte>(counts >> 8);
       } else {
-        out[i] = static_cast<std::byte>(to_u8((T - agc_lo_c_) * k));
+        out[i] = static_cast<std::byte>(to_u8((T - lo) * gain));
       }
     }
   }

@@ -81,6 +81,12 @@ class ThermalCamera {
   GBuffer gbuffer_;
   std::vector<float> temperature_;          // half resolution [°C]
   std::vector<float> fpn_pixel_, fpn_col_;  // full resolution unit patterns
+  /// where a full-resolution row or column samples the half-resolution render (bilinear)
+  struct Tap {
+    std::size_t i0 = 0, i1 = 0;
+    float f = 0;  // weight of i1
+  };
+  std::vector<Tap> row_taps_, col_taps_;
   std::vector<std::byte> last_frame_;
   std::uint64_t index_ = 0, nucs_ = 0;
   double last_nuc_s_ = 0, next_nuc_s_ = 0;

@@ -1,6 +1,7 @@
 #include "tools/sim/visible_camera.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace posed::sim {
@@ -45,7 +46,8 @@ void VisibleCamera::emit(std::vector<std::byte>& out) {
       scene_.trajectory.T_map_base(schedule_.true_time(index_)) * config_.T_base_cam;
   render_gbuffer(world, scene_.bvh, rays_, T_map_cam, 150.0, gbuffer_);
   const Eigen::Vector3d o = T_map_cam.translation();
-  // Lights that matter for this frame: the 8 nearest within 40 m.
+  // Lights that matter for this frame: the 8 nearest within 40 m, in float for the pixel loop
+  // (positions relative to the camera: millimetres of float rounding at 40 m light nothing).
   std::vector<std::pair<double, const PointLight*>> near;
   for (const PointLight& l : world.lights) {
     const double d = (l.p_map_m - o).norm();
@@ -54,84 +56,139 @@ void VisibleCamera::emit(std::vector<std::byte>& out) {
   std::sort(near.begin(), near.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   if (near.size() > 8) near.resize(8);
+  std::array<Eigen::Vector3f, 8> light_cam_m;  // light - camera, map axes [m]
+  std::array<float, 8> light_intensity{};
+  const std::size_t n_lights = near.size();
+  for (std::size_t k = 0; k < n_lights; ++k) {
+    light_cam_m[k] = (near[k].second->p_map_m - o).cast<float>();
+    light_intensity[k] = static_cast<float>(near[k].second->intensity);
+  }
 
   const int W = gbuffer_.width, H = gbuffer_.height;
   const auto N = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
-  radiance_.resize(3 * N);
   const Eigen::Matrix3d R = T_map_cam.linear();
+  const auto ambient = static_cast<float>(world.ambient);
+  const auto headlight = static_cast<float>(world.headlight);
+  const auto sky = static_cast<float>(world.sky_radiance);
+  // Irradiance at the pixel (x, y) on `face` of `box`, `t_m` along its ray: ambient light, the
+  // headlight at the camera, the point lights (Lambert's cosine, inverse square).
+  const auto irradiance = [&](int x, int y, std::int32_t box, std::uint8_t face, float t_m) {
+    const Eigen::Vector3f n =
+        face_normal_map(world.boxes[static_cast<std::size_t>(box)], face).cast<float>();
+    const Eigen::Vector3f d = (R * rays_.dir(x, y)).cast<float>();
+    const Eigen::Vector3f p_cam = t_m * d;
+    float E = ambient + headlight * std::max(0.0f, -n.dot(d)) / (t_m * t_m + 1.0f);
+    for (std::size_t k = 0; k < n_lights; ++k) {
+      const Eigen::Vector3f to = light_cam_m[k] - p_cam;
+      const float d2 = to.squaredNorm();
+      const float c = n.dot(to);
+      if (c > 0) E += light_intensity[k] * c / (d2 * std::sqrt(d2));
+    }
+    return E;
+  };
+  // Irradiance per pixel. It is smooth across a plane (point lights metres away, cells a few
+  // centimetres wide), so in cells whose four grid rays met one face it is interpolated from
+  // those four corners; elsewhere (edges, corners of boxes) every pixel gets its own.
+  const int gw = grid_points(W), gh = grid_points(H);
+  grid_irradiance_.resize(static_cast<std::size_t>(gw * gh));
+  for (int j = 0; j < gh; ++j)
+    for (int i = 0; i < gw; ++i) {
+      const int x = grid_pixel(i, W), y = grid_pixel(j, H);
+      const std::size_t g = static_cast<std::size_t>(j * gw + i),
+                        p = static_cast<std::size_t>(y * W + x);
+      grid_irradiance_[g] =
+          gbuffer_.grid_box[g] >= 0 && gbuffer_.box[p] == gbuffer_.grid_box[g]
+              ? irradiance(x, y, gbuffer_.box[p], gbuffer_.face[p], gbuffer_.t_m[p])
+              : -1.0f;  // not usable: the pixel's own hit differs
+    }
+  irradiance_.resize(N);
+  for (int j = 0; j + 1 < gh; ++j)
+    for (int i = 0; i + 1 < gw; ++i) {
+      const int x0 = grid_pixel(i, W), x1 = grid_pixel(i + 1, W), xe = cell_end(i, gw, W);
+      const int y0 = grid_pixel(j, H), y1 = grid_pixel(j + 1, H), ye = cell_end(j, gh, H);
+      const std::size_t g = static_cast<std::size_t>(j * gw + i);
+      const float e00 = grid_irradiance_[g], e10 = grid_irradiance_[g + 1];
+      const float e01 = grid_irradiance_[g + static_cast<std::size_t>(gw)];
+      const float e11 = grid_irradiance_[g + static_cast<std::size_t>(gw) + 1];
+      const bool smooth = gbuffer_.plane_cell[static_cast<std::size_t>(j * gbuffer_.cells_x + i)] &&
+                          e00 >= 0 && e10 >= 0 && e01 >= 0 && e11 >= 0;
+      for (int y = y0; y < ye; ++y) {
+        const float fy = static_cast<float>(y - y0) / static_cast<float>(y1 - y0);
+        const float left = e00 + fy * (e01 - e00), right = e10 + fy * (e11 - e10);
+        for (int x = x0; x < xe; ++x) {
+          const std::size_t p = static_cast<std::size_t>(y * W + x);
+          if (gbuffer_.box[p] < 0) continue;
+          irradiance_[p] =
+              smooth
+                  ? left + static_cast<float>(x - x0) / static_cast<float>(x1 - x0) * (right - left)
+                  : irradiance(x, y, gbuffer_.box[p], gbuffer_.face[p], gbuffer_.t_m[p]);
+        }
+      }
+    }
+  // Scene radiance (B, G, R) of one pixel: albedo (with the material's texture) times the
+  // irradiance, plus emission, tinted.
+  const auto radiance = [&](int x, int y, std::size_t i, std::array<float, 3>& L) {
+    const std::int32_t box = gbuffer_.box[i];
+    if (box < 0) {
+      L = {sky, sky, sky};
+      return;
+    }
+    const Box& b = world.boxes[static_cast<std::size_t>(box)];
+    const Material& m = world.materials[b.material];
+    auto albedo = static_cast<float>(m.albedo);
+    if (m.texture != kTexturePlain) {
+      const Eigen::Vector3d p = o + static_cast<double>(gbuffer_.t_m[i]) * (R * rays_.dir(x, y));
+      const double tv = texture_value(m.texture, face_uv_m(b, gbuffer_.face[i], p),
+                                      static_cast<std::uint32_t>(box));
+      albedo *= static_cast<float>(std::max(0.0, 1.0 + m.texture_contrast * 2.0 * (tv - 0.5)));
+    }
+    const float E = irradiance_[i];
+    const auto emission = static_cast<float>(m.emission);
+    for (int c = 0; c < 3; ++c)
+      L[static_cast<std::size_t>(c)] = static_cast<float>(m.tint_bgr[c]) * (albedo * E + emission);
+  };
+
+  // Exposure: this frame with the gain the auto-exposure chose from the previous one.
+  const auto scale = static_cast<float>(255.0 * gain_);
+  const float read_noise2 = 2.25f * scale / 255.0f;  // (1.5 DN)² amplified by the gain
+  // Shot noise variance 0.25 DN per DN of signal, plus read noise amplified by the gain.
+  const auto expose = [&](std::array<float, 3>& v) {
+    for (float& c : v) {
+      c *= scale;
+      if (config_.noise) c += std::sqrt(0.25f * std::max(c, 0.0f) + read_noise2) * noise_.normal();
+      c = std::clamp(c, 0.0f, 255.0f);
+    }
+  };
+  // BT.601 limited range YUYV: Y0 U Y1 V per pixel pair (rows have an even width), chroma
+  // averaged over the pair.
+  out.resize(N * 2);
   double sum_y = 0;
+  std::array<float, 3> p0{}, p1{};
   for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
+    for (int x = 0; x + 1 < W; x += 2) {
       const std::size_t i =
           static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
-      Eigen::Vector3d L;
-      if (gbuffer_.box[i] < 0) {
-        L = Eigen::Vector3d::Constant(world.sky_radiance);
-      } else {
-        const Box& b = world.boxes[static_cast<std::size_t>(gbuffer_.box[i])];
-        const Material& m = world.materials[b.material];
-        const Eigen::Vector3d d = R * rays_.dir(x, y);
-        const double tm = gbuffer_.t_m[i];
-        const Eigen::Vector3d p = o + tm * d;
-        const Eigen::Vector3d n = face_normal_map(b, gbuffer_.face[i]);
-        double albedo = m.albedo;
-        if (m.texture != kTexturePlain) {
-          const double tv = texture_value(m.texture, face_uv_m(b, gbuffer_.face[i], p),
-                                          static_cast<std::uint32_t>(gbuffer_.box[i]));
-          albedo *= std::max(0.0, 1.0 + m.texture_contrast * 2.0 * (tv - 0.5));
-        }
-        double E = world.ambient + world.headlight * std::max(0.0, -n.dot(d)) / (tm * tm + 1.0);
-        for (const auto& [dist, light] : near) {
-          const Eigen::Vector3d to = light->p_map_m - p;
-          const double d2 = to.squaredNorm();
-          const double c = n.dot(to) / std::sqrt(d2);
-          if (c > 0) E += light->intensity * c / d2;
-        }
-        L = m.tint_bgr * (albedo * E + m.emission);
-      }
-      radiance_[3 * i] = static_cast<float>(L[0]);
-      radiance_[3 * i + 1] = static_cast<float>(L[1]);
-      radiance_[3 * i + 2] = static_cast<float>(L[2]);
-      sum_y += 0.114 * L[0] + 0.587 * L[1] + 0.299 * L[2];
+      radiance(x, y, i, p0);
+      radiance(x + 1, y, i + 1, p1);
+      sum_y += 0.114f * (p0[0] + p1[0]) + 0.587f * (p0[1] + p1[1]) + 0.299f * (p0[2] + p1[2]);
+      expose(p0);
+      expose(p1);
+      const float y0 = 16 + (65.481f * p0[2] + 128.553f * p0[1] + 24.966f * p0[0]) / 255.0f;
+      const float y1 = 16 + (65.481f * p1[2] + 128.553f * p1[1] + 24.966f * p1[0]) / 255.0f;
+      const float r = 0.5f * (p0[2] + p1[2]), g = 0.5f * (p0[1] + p1[1]),
+                  b = 0.5f * (p0[0] + p1[0]);
+      const float u = 128 + (-37.797f * r - 74.203f * g + 112.0f * b) / 255.0f;
+      const float v = 128 + (112.0f * r - 93.786f * g - 18.214f * b) / 255.0f;
+      out[2 * i] = static_cast<std::byte>(to_u8(y0));
+      out[2 * i + 1] = static_cast<std::byte>(to_u8(u));
+      out[2 * i + 2] = static_cast<std::byte>(to_u8(y1));
+      out[2 * i + 3] = static_cast<std::byte>(to_u8(v));
     }
   }
   // Auto-exposure: steer the mean to mid-grey, at most max_gain; one frame of lag like a real AE.
-  const double scale = 255.0 * gain_;
   const double mean = sum_y / static_cast<double>(N);
   const double wanted = mean > 1e-6 ? 0.45 / mean : config_.max_gain;
   gain_ = std::clamp(gain_ * std::pow(wanted / gain_, 0.5), 0.05, config_.max_gain);
-
-  out.resize(N * 2);
-  const double read_noise2 = 2.25 * scale / 255.0;  // (1.5 DN)² amplified by the gain
-  auto pixel_bgr = [&](std::size_t i, double& B, double& G, double& Rr) {
-    B = radiance_[3 * i] * scale;
-    G = radiance_[3 * i + 1] * scale;
-    Rr = radiance_[3 * i + 2] * scale;
-    if (config_.noise) {
-      // Shot noise variance 0.25 DN per DN of signal, plus read noise amplified by the gain.
-      B += std::sqrt(0.25 * std::max(B, 0.0) + read_noise2) * noise_.normal();
-      G += std::sqrt(0.25 * std::max(G, 0.0) + read_noise2) * noise_.normal();
-      Rr += std::sqrt(0.25 * std::max(Rr, 0.0) + read_noise2) * noise_.normal();
-    }
-    B = std::clamp(B, 0.0, 255.0);
-    G = std::clamp(G, 0.0, 255.0);
-    Rr = std::clamp(Rr, 0.0, 255.0);
-  };
-  // BT.601 limited range YUYV: Y0 U Y1 V per pixel pair, chroma averaged over the pair.
-  for (std::size_t i = 0; i + 1 < N; i += 2) {
-    double b0, g0, r0, b1, g1, r1;
-    pixel_bgr(i, b0, g0, r0);
-    pixel_bgr(i + 1, b1, g1, r1);
-    const double y0 = 16 + (65.481 * r0 + 128.553 * g0 + 24.966 * b0) / 255.0;
-    const double y1 = 16 + (65.481 * r1 + 128.553 * g1 + 24.966 * b1) / 255.0;
-    const double r = 0.5 * (r0 + r1), g = 0.5 * (g0 + g1), b = 0.5 * (b0 + b1);
-    const double u = 128 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0;
-    const double v = 128 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0;
-    out[2 * i] = static_cast<std::byte>(to_u8(y0));
-    out[2 * i + 1] = static_cast<std::byte>(to_u8(u));
-    out[2 * i + 2] = static_cast<std::byte>(to_u8(y1));
-    out[2 * i + 3] = static_cast<std::byte>(to_u8(v));
-  }
   ++index_;
 }
 

@@ -53,7 +53,8 @@ class VisibleCamera {
   FastNoise noise_;
   PixelRays rays_;
   GBuffer gbuffer_;
-  std::vector<float> radiance_;
+  std::vector<float> irradiance_;       // per pixel, this frame
+  std::vector<float> grid_irradiance_;  // per grid point, -1 = not on its pixel's face
   std::uint64_t index_ = 0;
   double gain_ = 1.0;
 };

@@ -100,8 +100,12 @@ struct RayHit {
 std::optional<RayHit> intersect_box(const Box& box, const Eigen::Vector3d& origin_m,
                                     const Eigen::Vector3d& dir, double t_max_m);
 
-/// Unit outward normal of a face, in map axes.
-Eigen::Vector3d face_normal_map(const Box& box, std::uint8_t face);
+/// Unit outward normal of a face, in map axes (inline: cameras ask per pixel).
+inline Eigen::Vector3d face_normal_map(const Box& box, std::uint8_t face) {
+  const int axis = face / 2;
+  const double sign = (face % 2 == 1) ? 1.0 : -1.0;
+  return sign * box.R_map_box.col(axis);
+}
 
 /// Texture coordinates of a map point on a face, in metres along the face's two axes.
 Eigen::Vector2d face_uv_m(const Box& box, std::uint8_t face, const Eigen::Vector3d& p_map_m);
