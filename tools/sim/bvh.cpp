@@ -221,42 +221,8 @@ std::optional<RayHit> Bvh::hit_box(std::uint32_t box, const Ray& r, double t_max
       }
       break;
   }
-  double t_near = -kInf, t_far = kInf;
-  int near_axis = 0, far_axis = 0;
-  for (int a = 0; a < 3; ++a) {
-    const auto i = static_cast<std::size_t>(a);
-    const double h = p.half_m[i];
-    if (std::abs(d[i]) < 1e-15) {
-      if (o[i] < -h || o[i] > h) return std::nullopt;  // parallel and outside the slab
-      continue;
-    }
-    double t0 = (-h - o[i]) * inv[i], t1 = (h - o[i]) * inv[i];
-    if (t0 > t1) std::swap(t0, t1);
-    if (t0 > t_near) {
-      t_near = t0;
-      near_axis = a;
-    }
-    if (t1 < t_far) {
-      t_far = t1;
-      far_axis = a;
-    }
-    if (t_near > t_far) return std::nullopt;
-  }
-  RayHit hit;
-  hit.box = box;
-  if (t_near > 0.0) {
-    if (t_near > t_max_m) return std::nullopt;
-    hit.t_m = t_near;
-    hit.face = static_cast<std::uint8_t>(2 * near_axis +
-                                         (d[static_cast<std::size_t>(near_axis)] < 0 ? 1 : 0));
-  } else if (t_far > 0.0) {
-    if (t_far > t_max_m) return std::nullopt;
-    hit.t_m = t_far;  // inside the box (a tunnel's rock block around the sensor): its far wall
-    hit.face = static_cast<std::uint8_t>(2 * far_axis +
-                                         (d[static_cast<std::size_t>(far_axis)] > 0 ? 1 : 0));
-  } else {
-    return std::nullopt;
-  }
+  std::optional<RayHit> hit = slab_hit(o, d, inv, p.half_m, t_max_m);
+  if (hit) hit->box = box;
   return hit;
 }
 

@@ -79,9 +79,10 @@ class PixelRays {
 void render_gbuffer(const World& world, const Bvh& bvh, const PixelRays& rays,
                     const Eigen::Isometry3d& T_map_cam, double max_range_m, GBuffer& out);
 
-/// Rounds a value to the nearest byte value, clamping to [0, 255] (no libm call: per pixel).
-inline std::uint8_t to_u8(double v) {
-  return static_cast<std::uint8_t>(v <= 0.0 ? 0 : v >= 255.0 ? 255 : static_cast<int>(v + 0.5));
+/// Rounds a value to the nearest byte value, clamping to [0, 255]: per pixel, so no libm call
+/// and no branches (clamp first, then truncate the non-negative value + 0.5).
+inline std::uint8_t to_u8(float v) {
+  return static_cast<std::uint8_t>(static_cast<int>(std::clamp(v, 0.0f, 255.0f) + 0.5f));
 }
 
 }  // namespace posed::sim

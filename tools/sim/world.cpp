@@ -33,42 +33,9 @@ std::optional<RayHit> intersect_box(const Box& box, const Eigen::Vector3d& origi
                                     const Eigen::Vector3d& dir, double t_max_m) {
   const Eigen::Vector3d o = box.R_map_box.transpose() * (origin_m - box.center_m);
   const Eigen::Vector3d d = box.R_map_box.transpose() * dir;
-  double t_near = -std::numeric_limits<double>::infinity();
-  double t_far = std::numeric_limits<double>::infinity();
-  int near_axis = 0, far_axis = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double h = box.half_extent_m[a];
-    if (std::abs(d[a]) < 1e-15) {
-      if (o[a] < -h || o[a] > h) return std::nullopt;  // parallel and outside the slab
-      continue;
-    }
-    const double inv = 1.0 / d[a];
-    double t0 = (-h - o[a]) * inv, t1 = (h - o[a]) * inv;
-    if (t0 > t1) std::swap(t0, t1);
-    if (t0 > t_near) {
-      t_near = t0;
-      near_axis = a;
-    }
-    if (t1 < t_far) {
-      t_far = t1;
-      far_axis = a;
-    }
-    if (t_near > t_far) return std::nullopt;
-  }
-  RayHit hit;
-  hit.box = 0;
-  if (t_near > 0.0) {
-    if (t_near > t_max_m) return std::nullopt;
-    hit.t_m = t_near;
-    hit.face = static_cast<std::uint8_t>(2 * near_axis + (d[near_axis] < 0 ? 1 : 0));
-  } else if (t_far > 0.0) {
-    if (t_far > t_max_m) return std::nullopt;
-    hit.t_m = t_far;  // inside the box (a tunnel's rock block around the sensor): its far wall
-    hit.face = static_cast<std::uint8_t>(2 * far_axis + (d[far_axis] > 0 ? 1 : 0));
-  } else {
-    return std::nullopt;
-  }
-  return hit;
+  return slab_hit({o.x(), o.y(), o.z()}, {d.x(), d.y(), d.z()},
+                  {1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z()},
+                  {box.half_extent_m.x(), box.half_extent_m.y(), box.half_extent_m.z()}, t_max_m);
 }
 
 Eigen::Vector2d face_uv_m(const Box& box, std::uint8_t face, const Eigen::Vector3d& p_map_m) {
