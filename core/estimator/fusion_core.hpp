@@ -49,6 +49,13 @@ class FusionCore {
   virtual void add_imu(const ImuSample& sample, std::vector<NavState>& states) = 0;
   /// One lidar scan; its pool buffer returns when the core drops the scan. Appends states.
   virtual void add_scan(LidarScan scan, std::vector<NavState>& states) = 0;
+  /// One camera frame (stamp on the host clock); its pool buffer returns when the core drops
+  /// the image. A core without a visual front end drops it at once.
+  virtual void add_image(CameraStream stream, Image image, std::vector<NavState>& states) {
+    (void)stream;
+    (void)image;
+    (void)states;
+  }
   virtual EstimatorMode mode() const = 0;
   /// one line for the summary and logs, e.g. "strapdown (IMU-only dead reckoning ...)"
   virtual std::string_view description() const = 0;

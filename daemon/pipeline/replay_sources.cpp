@@ -57,6 +57,10 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
+  // Cameras replay when recorded; a recording of other streams (a depth camera, a second IMU)
+  // is listed but has no stage to go to.
+  if (streams.count("visible")) out.built.sources.visible = make("visible");
+  if (streams.count("thermal")) out.built.sources.thermal = make("thermal");
   for (const auto& s : streams) out.streams += (out.streams.empty() ? "" : ", ") + s;
   return out;
 }

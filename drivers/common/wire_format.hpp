@@ -17,8 +17,8 @@ inline constexpr std::string_view kVelodyneData = "velodyne-udp-data";
 inline constexpr std::string_view kVelodynePosition = "velodyne-udp-position";
 /// one Linux struct can_frame / canfd_frame (drivers/imu/can_frame.hpp) per chunk
 inline constexpr std::string_view kCanFrame = "linux-can-frame";
-/// one uvcvideo metadata buffer (struct uvc_meta_buf + UVC payload header + Intel D4xx blocks,
-/// drivers/camera/d4xx_metadata.hpp) per chunk, delivered just before its frame's bytes
+/// one D4xx frame-metadata buffer (struct uvc_meta_buf + UVC payload header + Intel blocks,
+/// drivers/camera/d4xx_metadata.hpp) per chunk, delivered just before the frame it describes
 inline constexpr std::string_view kUvcMetaD4xx = "uvc-meta-d4xx";
 /// whole IIO scan records of a hid-sensor-accel-3d device as read from /dev/iio:deviceN. The
 /// record layout follows the name: `iio-hid-accel-3d;in_accel_x:le:s16/32>>0;...` lists the
