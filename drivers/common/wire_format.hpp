@@ -20,5 +20,11 @@ inline constexpr std::string_view kCanFrame = "linux-can-frame";
 /// one D4xx frame-metadata buffer (struct uvc_meta_buf + UVC payload header + Intel blocks,
 /// drivers/camera/d4xx_metadata.hpp) per chunk, delivered just before the frame it describes
 inline constexpr std::string_view kUvcMetaD4xx = "uvc-meta-d4xx";
+/// whole IIO scan records of a hid-sensor-accel-3d device as read from /dev/iio:deviceN. The
+/// record layout follows the name: `iio-hid-accel-3d;in_accel_x:le:s16/32>>0;...` lists the
+/// enabled scan elements in index order with their sysfs `_type` (drivers/camera/iio_scan.hpp)
+inline constexpr std::string_view kIioAccel3d = "iio-hid-accel-3d";
+/// the same for a hid-sensor-gyro-3d device (`in_anglvel_*` elements)
+inline constexpr std::string_view kIioGyro3d = "iio-hid-gyro-3d";
 
 }  // namespace posed::drivers::wire
