@@ -41,6 +41,15 @@ struct PipelineSources {
   std::unique_ptr<drivers::Source> imu;
   /// VLP-32C UDP payloads, channel 0 data, 1 position (live UDP, pcap, or replayed); optional
   std::unique_ptr<drivers::Source> lidar;
+
+  /// Calls `f(std::unique_ptr<drivers::Source>&)` on every slot above, set or not, so code that
+  /// treats all Sources alike (the recording tap, `posectl record`) needs no list of its own:
+  /// a new Source field must be added here too.
+  template <class F>
+  void for_each(F&& f) {
+    f(imu);
+    f(lidar);
+  }
 };
 
 /// Callbacks run on the publisher thread.
