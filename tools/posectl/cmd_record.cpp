@@ -141,9 +141,10 @@ int run_record(int argc, char** argv) {
       POSED_LOG_WARN("%s: not open yet: %s; retrying", p->name.c_str(), p->open_error.c_str());
     }
   }
+  char limit[64] = "";
+  if (duration_s > 0) std::snprintf(limit, sizeof limit, " for %.1f s", duration_s);
   std::fprintf(stderr, "posectl record: recording %s to %s (%s chunks)%s\n", names.c_str(),
-               out_path.c_str(), compression_text.c_str(),
-               duration_s > 0 ? (" for " + std::to_string(duration_s) + " s").c_str() : "");
+               out_path.c_str(), compression_text.c_str(), limit);
   for (auto& p : pumps) p->thread = std::thread([&p = *p] { p.run(); });
 
   const HostTime started = drivers::host_now();
@@ -178,7 +179,7 @@ int run_record(int argc, char** argv) {
       last_report = now;
       const rec::RecorderCounters c = recorder.counters();
       char head[128];
-      std::snprintf(head, sizeof head, "posectl record: %.0f s, %.1f MB on disk",
+      std::snprintf(head, sizeof head, "posectl record: %.0f s, %.2f MB on disk",
                     (now - started).seconds(), mb(c.bytes_on_disk));
       std::string line = head;
       for (const auto& ch : c.channels) {

@@ -17,6 +17,9 @@ std::span<const Command> commands() {
               "simulate the rig in a scenario: a recording with raw sensor data and ground truth",
               run_sim},
       Command{"export", "write an MCAP recording's poses (TUM) or its lidar map (PCD)", run_export},
+      Command{"replay",
+              "re-emit a recording onto UDP and a pty with its timing (hardware-in-the-loop)",
+              run_replay},
       Command{"record", "record the raw bytes of the config's live Sources to MCAP (no fusion)",
               run_record},
   };
