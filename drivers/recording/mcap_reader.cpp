@@ -139,6 +139,13 @@ void McapReader::issue(std::uint64_t offset, std::string what) {
   if (issues_.size() < 100) issues_.push_back({offset, std::move(what)});
 }
 
+void McapReader::unknown(std::uint64_t offset, std::int64_t chunk_byte, std::uint8_t opcode,
+                         std::uint64_t length) {
+  ++counters_.unknown_records;
+  if (unknown_records_.size() < 100)
+    unknown_records_.push_back({offset, chunk_byte, opcode, length});
+}
+
 void McapReader::stop(std::uint64_t offset, std::string what) {
   stop_reason_ = fmt("%s at offset %llu; read up to offset %llu of %llu B", what.c_str(),
                      ull(offset), ull(offset), ull(file_.size()));
@@ -152,6 +159,7 @@ bool McapReader::open_common(std::string& error) {
   schemas_.clear();
   metadata_.clear();
   issues_.clear();
+  unknown_records_.clear();
   summary_ = {};
   counters_ = {};
   if (file_.size() < mcap::kMagicSize ||
@@ -381,6 +389,7 @@ bool McapReader::next_in_chunk(McapMessage& out) {
       chunk_pos_ = chunk_records_.size();
       break;
     }
+    const std::size_t record_at = chunk_pos_;
     chunk_pos_ += mcap::kRecordPrefixSize + static_cast<std::size_t>(len);
     switch (static_cast<Op>(op)) {
       case Op::kSchema:
@@ -393,8 +402,9 @@ bool McapReader::next_in_chunk(McapMessage& out) {
         if (decode_message(body, chunk_offset_, out)) return true;
         break;
       default:
-        ++counters_.unknown_records;
-        break;  // only Schema/Channel/Message belong in chunks; anything else is skipped
+        // Only Schema/Channel/Message belong in chunks; anything else is skipped.
+        unknown(chunk_offset_, static_cast<std::int64_t>(record_at), op, len);
+        break;
     }
   }
   chunk_records_ = {};
@@ -581,7 +591,7 @@ bool McapReader::next(McapMessage& out) {
       case Op::kSummaryOffset:
         break;  // index records: a linear reader does not need them
       default:
-        ++counters_.unknown_records;  // unknown opcode: skipped, as the spec says
+        unknown(at, -1, op, len);  // unknown opcode: skipped, as the spec says
         break;
     }
   }

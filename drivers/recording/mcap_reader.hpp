@@ -55,6 +55,16 @@ struct McapIssue {
   std::string what;          ///< "truncated Chunk record: needs 1048600 B, 5120 B left"
 };
 
+/// A record whose opcode this reader does not know (or that does not belong where it was found),
+/// skipped as the spec says: application extensions (0x80-0xFF), opcodes of a newer spec.
+struct McapUnknownRecord {
+  std::uint64_t offset = 0;  ///< file offset of the record, or of the Chunk holding it [B]
+  /// position in the Chunk's uncompressed records; -1 for a record of the data section [B]
+  std::int64_t chunk_byte = -1;
+  std::uint8_t opcode = 0;
+  std::uint64_t length = 0;  ///< content length [B]
+};
+
 struct McapMetadataRecord {
   std::string name;
   std::map<std::string, std::string> entries;
@@ -129,6 +139,8 @@ class McapReader {
   const std::map<std::uint16_t, McapSchemaRecord>& schemas() const { return schemas_; }
   const McapSchemaRecord* schema(std::uint16_t id) const;
   const std::vector<McapIssue>& issues() const { return issues_; }
+  /// the first 100 records skipped for their opcode (counters().unknown_records counts all)
+  const std::vector<McapUnknownRecord>& unknown_records() const { return unknown_records_; }
   const McapSummaryInfo& summary() const { return summary_; }
   const std::vector<McapMetadataRecord>& metadata() const { return metadata_; }
   const McapReaderCounters& counters() const { return counters_; }
@@ -141,6 +153,8 @@ class McapReader {
   bool parse_schema(std::span<const std::byte> body, std::uint64_t offset);
   bool parse_channel(std::span<const std::byte> body, std::uint64_t offset);
   void issue(std::uint64_t offset, std::string what);
+  void unknown(std::uint64_t offset, std::int64_t chunk_byte, std::uint8_t opcode,
+               std::uint64_t length);
   void stop(std::uint64_t offset, std::string what);
   bool enter_chunk(std::span<const std::byte> body, std::uint64_t offset);
   bool next_in_chunk(McapMessage& out);
@@ -173,6 +187,7 @@ class McapReader {
   std::map<std::uint16_t, McapSchemaRecord> schemas_;
   std::vector<McapMetadataRecord> metadata_;
   std::vector<McapIssue> issues_;
+  std::vector<McapUnknownRecord> unknown_records_;
   McapSummaryInfo summary_;
   McapReaderCounters counters_;
 };
