@@ -129,6 +129,20 @@ TEST(PosectlRecord, RecordsTheSourcesUntilSigintAndPosedReplaysTheFile) {
     }
   }
 
+  // posectl inspect FILE.mcap lists it: the lidar channel with what was sent, and no error.
+  {
+    TempDir inspect_dir;
+    PosedProcess inspect({build_dir() + "/tools/posectl/posectl", "inspect", recording}, {},
+                         inspect_dir);
+    ASSERT_EQ(inspect.wait_for_exit(30s), 0) << inspect.out() << inspect.err();
+    const std::string listing = inspect.out();
+    const auto lidar = listing.find("/posed/raw/lidar\n");
+    ASSERT_NE(lidar, std::string::npos) << listing;
+    EXPECT_EQ(number_after(listing.substr(lidar), "messages "), 4500) << listing;
+    EXPECT_NE(listing.find("state    complete"), std::string::npos) << listing;
+    EXPECT_EQ(listing.find("errors ("), std::string::npos) << listing;
+  }
+
   // posed takes the file: every recorded lidar packet and IMU frame is decoded again.
   TempDir replay_dir;
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
