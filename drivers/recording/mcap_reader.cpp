@@ -183,7 +183,9 @@ bool McapReader::open_common(std::string& error) {
     return false;
   }
   data_start_ = mcap::kMagicSize + in.pos();
+  summary_channels_.reset();
   read_summary();
+  for (const auto& [id, c] : channels_) summary_channels_.set(id);
   rewind();
   return true;
 }
@@ -329,6 +331,7 @@ bool McapReader::parse_channel(std::span<const std::byte> body, std::uint64_t of
     issue(offset, fmt("Channel %u (%s) refers to schema %u, which is not defined before it", c.id,
                       c.topic.c_str(), c.schema_id));
   }
+  seen_channels_.set(c.id);
   if (const auto it = channels_.find(c.id); it != channels_.end()) {
     // Repeats (summary copy, next chunk) must be identical (spec); keep the first one so the
     // pointers handed out in McapMessage stay valid.
@@ -347,6 +350,7 @@ void McapReader::rewind() {
   crc_pos_ = 0;
   chunk_records_ = {};
   chunk_pos_ = 0;
+  seen_channels_.reset();
 }
 
 bool McapReader::decode_message(std::span<const std::byte> body, std::uint64_t offset,
@@ -362,7 +366,7 @@ bool McapReader::decode_message(std::span<const std::byte> body, std::uint64_t o
     return false;
   }
   const auto it = channels_.find(channel_id);
-  if (it == channels_.end()) {
+  if (it == channels_.end() || !(summary_channels_[channel_id] || seen_channels_[channel_id])) {
     ++counters_.orphan_messages;
     if (counters_.orphan_messages <= 10) {
       issue(offset, fmt("Message on channel %u, which has no Channel record", channel_id));

@@ -10,6 +10,7 @@
 // on wherever the format allows (unknown opcodes are skipped as the spec says; a chunk with a bad
 // CRC or an unknown compression is skipped) and stops at the first record cut short.
 
+#include <bitset>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -185,6 +186,11 @@ class McapReader {
 
   std::map<std::uint16_t, McapChannelRecord> channels_;
   std::map<std::uint16_t, McapSchemaRecord> schemas_;
+  // Which channels a message may use: those of a usable summary, and those whose Channel record
+  // this pass has read. Records learnt in an earlier pass stay in channels_ (McapMessage points
+  // into it) but do not count, so every pass over a damaged file reads the same messages.
+  std::bitset<65536> summary_channels_;
+  std::bitset<65536> seen_channels_;
   std::vector<McapMetadataRecord> metadata_;
   std::vector<McapIssue> issues_;
   std::vector<McapUnknownRecord> unknown_records_;
