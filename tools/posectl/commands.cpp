@@ -7,7 +7,8 @@ namespace posed::posectl {
 std::span<const Command> commands() {
   static const std::array kCommands = {
       Command{"bench", "run benchmarks; prints `NAME METRIC VALUE UNIT` lines", run_bench},
-      Command{"inspect", "decode a raw sensor capture: one line per frame, then a summary",
+      Command{"inspect",
+              "decode a raw sensor capture frame by frame, or list a recording (FILE.mcap)",
               run_inspect},
       Command{"echo", "print posed's DDS topics (odom, pose, status) with rate and latency",
               run_echo},
