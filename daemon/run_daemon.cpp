@@ -5,15 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <thread>
 
 #include "daemon/build_info.hpp"
-#include "daemon/config/config_loader.hpp"
 #include "daemon/dds/publisher.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
@@ -55,15 +52,6 @@ struct PublishTally {
   /// the estimator publishes optimised states (so pose is not decimated from odom)
   bool have_optimised = false;
 };
-
-/// A file's contents for the recording's metadata ("" when unset or unreadable).
-std::string read_text_file(const std::string& path) {
-  if (path.empty()) return {};
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 /// Writes the map and keyframes the fusion core kept; false (logged) when there is none or a
 /// file cannot be written. `line` gets the summary line.
@@ -155,40 +143,13 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   std::unique_ptr<drivers::recording::Recorder> recorder;
   if (!options.record_path.empty()) {
     recorder = std::make_unique<drivers::recording::Recorder>();
-    // Every channel carries the effective configuration: a recording says how it was made.
-    const std::string effective_config = config::print_config(config);
     drivers::recording::RecorderOptions recorder_options;
     recorder_options.host_to_wall = to_wall;
     if (!recorder->open(options.record_path, recorder_options, error)) {
       POSED_LOG_ERROR("cannot record: %s", error.c_str());
       return 1;
     }
-    built.sources.imu = std::make_unique<pipeline::RecordingTap>(
-        std::move(built.sources.imu), *recorder,
-        std::map<std::string, std::string>{{"posed.imu.source", config.imu.source},
-                                           {"posed.imu.device", config.imu.serial_device},
-                                           {"posed.config", effective_config}});
-    if (built.sources.lidar) {
-      built.sources.lidar = std::make_unique<pipeline::RecordingTap>(
-          std::move(built.sources.lidar), *recorder,
-          std::map<std::string, std::string>{
-              {"posed.lidar.address", config.lidar.address},
-              {"posed.lidar.calibration", config.lidar.calibration},
-              {"posed.lidar.calibration_text", read_text_file(config.lidar.calibration)},
-              {"posed.config", effective_config}});
-    }
-    for (const CameraStream stream : {CameraStream::kVisible, CameraStream::kThermal}) {
-      std::unique_ptr<drivers::Source>& camera = built.sources.camera(stream);
-      if (!camera) continue;
-      const config::CameraSection& section = pipeline::camera_section(config, stream);
-      const std::string prefix = "posed." + std::string(to_string(stream)) + ".";
-      camera = std::make_unique<pipeline::RecordingTap>(
-          std::move(camera), *recorder,
-          std::map<std::string, std::string>{{prefix + "device", section.device},
-                                             {prefix + "source", section.source},
-                                             {prefix + "format", section.format},
-                                             {"posed.config", effective_config}});
-    }
+    pipeline::tap_sources(built.sources, *recorder, config);
     POSED_LOG_INFO("recording raw streams and poses to %s", options.record_path.c_str());
   }
 

@@ -55,6 +55,17 @@ struct PipelineSources {
   const drivers::Source* camera(CameraStream s) const {
     return s == CameraStream::kVisible ? visible.get() : thermal.get();
   }
+
+  /// Calls `f(std::unique_ptr<drivers::Source>&)` on every slot above, set or not, so code that
+  /// treats all Sources alike (the recording tap, `posectl record`) needs no list of its own:
+  /// a new Source field must be added here too.
+  template <class F>
+  void for_each(F&& f) {
+    f(imu);
+    f(lidar);
+    f(visible);
+    f(thermal);
+  }
 };
 
 /// Callbacks run on the publisher thread.

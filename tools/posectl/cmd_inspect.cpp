@@ -134,6 +134,7 @@ constexpr std::array kKinds = {
 void print_usage(std::FILE* out) {
   std::fprintf(out,
                "usage: posectl inspect KIND FILE [options]\n"
+               "       posectl inspect FILE.mcap [options]   (same as: posectl inspect mcap FILE)\n"
                "       posectl inspect KIND --help\n\n"
                "Decodes a raw capture and prints one line per frame/packet, then a summary.\n\n"
                "kinds:\n");
@@ -157,6 +158,10 @@ int run_inspect(int argc, char** argv) {
   }
   for (const auto& k : kKinds) {
     if (k.name == kind) return k.run(argc - 1, argv + 1);
+  }
+  // `posectl inspect FILE.mcap`: a recording needs no kind; argv[1] is then its FILE.
+  if (kind.size() > 5 && kind.substr(kind.size() - 5) == ".mcap") {
+    return run_inspect_mcap(argc, argv);
   }
   std::fprintf(stderr, "posectl inspect: unknown kind '%s'\n\n", argv[1]);
   print_usage(stderr);
