@@ -18,4 +18,16 @@ inline constexpr std::string_view kVelodynePosition = "velodyne-udp-position";
 /// one Linux struct can_frame / canfd_frame (drivers/imu/can_frame.hpp) per chunk
 inline constexpr std::string_view kCanFrame = "linux-can-frame";
 
+// ROS 1 messages imported from a bag (posectl import; docs/import.md): one serialized message
+// per chunk, named "ros1:" + the message type. Decoders: drivers/recording/ros1_messages.hpp.
+inline constexpr std::string_view kRos1Prefix = "ros1:";
+/// sensor_msgs/Imu: angular velocity [rad/s] and specific force [m/s^2], stamped by its header
+inline constexpr std::string_view kRos1Imu = "ros1:sensor_msgs/Imu";
+/// sensor_msgs/PointCloud2 in velodyne_pointcloud's layout (x y z intensity ring time)
+inline constexpr std::string_view kRos1PointCloud2 = "ros1:sensor_msgs/PointCloud2";
+/// sensor_msgs/Image (raw pixels; encoding in the message)
+inline constexpr std::string_view kRos1Image = "ros1:sensor_msgs/Image";
+/// sensor_msgs/CompressedImage (jpeg/png; format in the message)
+inline constexpr std::string_view kRos1CompressedImage = "ros1:sensor_msgs/CompressedImage";
+
 }  // namespace posed::drivers::wire
