@@ -17,6 +17,8 @@ std::span<const Command> commands() {
               "simulate the rig in a scenario: a recording with raw sensor data and ground truth",
               run_sim},
       Command{"export", "write an MCAP recording's poses (TUM) or its lidar map (PCD)", run_export},
+      Command{"import", "turn a pcap capture, candump log or ROS 1 bag into a posed recording",
+              run_import},
   };
   return kCommands;
 }

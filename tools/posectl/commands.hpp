@@ -23,5 +23,6 @@ int run_eval(int argc, char** argv);
 int run_sim(int argc, char** argv);
 int run_inspect_mcap(int argc, char** argv);
 int run_export(int argc, char** argv);
+int run_import(int argc, char** argv);
 
 }  // namespace posed::posectl
