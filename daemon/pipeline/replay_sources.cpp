@@ -23,7 +23,7 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   }
   std::set<std::string> streams;
   for (const auto& [id, channel] : reader.channels()) {
-    if (channel.message_encoding != recording::raw::kMessageEncoding) continue;
+    if (!recording::raw::is_stream_channel(channel.message_encoding, channel.metadata)) continue;
     const auto it = channel.metadata.find(std::string(recording::raw::kStreamKey));
     if (it != channel.metadata.end()) streams.insert(it->second);
   }
@@ -39,8 +39,12 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     }
   }
   if (!streams.count("imu")) {
-    error = options.path + ": no raw IMU stream (/posed/raw/imu) to replay; found: " +
-            (streams.empty() ? std::string("no raw streams") : *streams.begin());
+    std::string found;
+    for (const auto& s : streams) found += (found.empty() ? "" : ", ") + s;
+    error = options.path +
+            ": no IMU stream to replay (/posed/raw/imu, or an imported topic mapped to imu: "
+            "posectl import --topic-map TOPIC=imu); found: " +
+            (found.empty() ? std::string("no streams") : found);
     return out;
   }
 
@@ -57,7 +61,12 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
-  for (const auto& s : streams) out.streams += (out.streams.empty() ? "" : ", ") + s;
+  // Streams without a pipeline stage yet (visible, thermal, realsense_imu from an imported bag)
+  // are listed but not replayed.
+  for (const auto& s : streams) {
+    const bool replayed = s == "imu" || s == "lidar";
+    out.streams += (out.streams.empty() ? "" : ", ") + s + (replayed ? "" : " (not replayed)");
+  }
   return out;
 }
 

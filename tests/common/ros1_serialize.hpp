@@ -87,6 +87,25 @@ inline const std::string kPointCloud2Definition =
     "uint8 INT32   = 5\nuint8 UINT32  = 6\nuint8 FLOAT32 = 7\nuint8 FLOAT64 = 8\n"
     "string name\nuint32 offset\nuint8  datatype\nuint32 count\n";
 
+inline constexpr std::string_view kImageMd5 = "060021388200f6f0f447d0fcd9c64743";
+inline const std::string kImageDefinition =
+    std::string(
+        "Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\n"
+        "uint32 step\nuint8[] data\n"
+        "================================================================================\n"
+        "MSG: std_msgs/Header\n") +
+    std::string(kHeaderDefinition);
+
+inline std::vector<std::byte> image(std::uint32_t seq, std::int64_t stamp_ns,
+                                    std::string_view frame_id, std::uint32_t height,
+                                    std::uint32_t width, std::string_view encoding,
+                                    const std::vector<std::byte>& pixels) {
+  Serializer s;
+  s.header(seq, stamp_ns, frame_id).u32(height).u32(width).string(encoding).u8(0);
+  s.u32(height == 0 ? 0 : static_cast<std::uint32_t>(pixels.size() / height)).blob(pixels);
+  return std::move(s.bytes);
+}
+
 inline constexpr std::string_view kStringMd5 = "992ce8a1687cec8c8bd883ec73ca41d1";
 inline constexpr std::string_view kStringDefinition = "string data\n";
 
