@@ -313,6 +313,18 @@ TEST(BagReplay, ASimulatedDriveImportedFromARos1BagIsTrackedInTheBagsTimeBase) {
               r.ate_m.max);
   // The raw-packet replay of the same drive measures 1-2 cm; 10 cm is the bound.
   EXPECT_LT(r.ate_m.rmse, 0.10) << "ATE " << r.ate_m.rmse << " m over " << r.ate_m.count;
+
+  // The map export replays the imported bag through the same pipeline.
+  {
+    PosedProcess exporter({posectl, "export", imported, "--pcd", dir.file("map.pcd"), "--config",
+                           source_dir() + "/config/posed.yaml"},
+                          {}, dir);
+    ASSERT_EQ(exporter.wait_for_exit(120s), 0) << exporter.err() << exporter.out();
+  }
+  const std::string pcd = read_file(dir.file("map.pcd"));
+  const std::size_t points_at = pcd.find("\nPOINTS ");
+  ASSERT_NE(points_at, std::string::npos) << pcd.substr(0, 300);
+  EXPECT_GT(std::stoul(pcd.substr(points_at + 8)), 20'000u) << "a 15 s street drive maps more";
 }
 
 }  // namespace bag_replay_test
