@@ -60,7 +60,7 @@ InputKind detect_input(const std::string& path, std::string& what) {
     return InputKind::kRos1Bag;  // the reader names versions other than 2.0
   }
   // candump -l: "(1600000000.123456) can0 123#DEADBEEF"
-  if (head.size() > 3 && head[0] == '(' && head.find(").") == std::string::npos) {
+  if (head.size() > 3 && head[0] == '(') {
     const std::size_t close = head.find(')');
     const std::size_t dot = head.find('.');
     if (close != std::string::npos && dot != std::string::npos && dot < close &&
@@ -175,7 +175,10 @@ int run_import(int argc, char** argv) {
   app.add_option("--topic-map", topic_map,
                  "TOPIC=STREAM: feed a bag topic to a posed stream (lidar, imu, visible, "
                  "thermal, realsense_imu); adds to or overrides the default map; TOPIC= removes "
-                 "a default. Repeatable.");
+                 "a default. Repeatable.")
+      ->expected(1)  // one TOPIC=STREAM per flag, so a positional after it stays positional
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_option("--data-port", data_port, "Velodyne data port (pcap)")
       ->check(CLI::Range(1, 65535));
   app.add_option("--position-port", position_port, "Velodyne position port (pcap)")
