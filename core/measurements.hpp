@@ -105,4 +105,14 @@ struct Image {
   PayloadPool::Lease pixels;
 };
 
+/// The cameras of the rig, as streams of the pipeline.
+enum class CameraStream : std::uint8_t {
+  kVisible,  ///< the D435i colour camera
+  kThermal,  ///< the PLUG 617 thermal camera
+};
+
+constexpr std::string_view to_string(CameraStream s) {
+  return s == CameraStream::kVisible ? "visible" : "thermal";
+}
+
 }  // namespace posed

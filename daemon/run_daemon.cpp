@@ -17,6 +17,7 @@
 #include "daemon/dds/publisher.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
+#include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/pipeline.hpp"
 #include "daemon/pipeline/recording_tap.hpp"
 #include "daemon/pipeline/source_factory.hpp"
@@ -175,6 +176,18 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
               {"posed.lidar.calibration", config.lidar.calibration},
               {"posed.lidar.calibration_text", read_text_file(config.lidar.calibration)},
               {"posed.config", effective_config}});
+    }
+    for (const CameraStream stream : {CameraStream::kVisible, CameraStream::kThermal}) {
+      std::unique_ptr<drivers::Source>& camera = built.sources.camera(stream);
+      if (!camera) continue;
+      const config::CameraSection& section = pipeline::camera_section(config, stream);
+      const std::string prefix = "posed." + std::string(to_string(stream)) + ".";
+      camera = std::make_unique<pipeline::RecordingTap>(
+          std::move(camera), *recorder,
+          std::map<std::string, std::string>{{prefix + "device", section.device},
+                                             {prefix + "source", section.source},
+                                             {prefix + "format", section.format},
+                                             {"posed.config", effective_config}});
     }
     POSED_LOG_INFO("recording raw streams and poses to %s", options.record_path.c_str());
   }

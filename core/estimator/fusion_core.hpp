@@ -9,11 +9,13 @@
 // queues' latency — an estimator must tolerate that (e.g. through MeasurementGate).
 
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
 #include "core/estimator/nav_state.hpp"
 #include "core/estimator/strapdown.hpp"
+#include "core/lidar/scan_motion.hpp"
 #include "core/measurements.hpp"
 
 namespace posed {
@@ -42,6 +44,15 @@ struct MapExport {
   std::vector<Keyframe> keyframes;
 };
 
+/// The newest scan a core matched, deskewed to its end, and where it was: what a camera front
+/// end needs for lidar depth. The points stay valid until the core's next add_scan().
+struct MatchedScan {
+  std::uint64_t index = 0;  ///< counts matched scans from 1: a new value is a new scan [1]
+  HostTime stamp;           ///< the scan's end, where the points are deskewed to
+  Eigen::Isometry3d T_map_lidar = Eigen::Isometry3d::Identity();
+  std::span<const lidar::ScanPoint> points_lidar;  ///< in the lidar frame at `stamp`
+};
+
 class FusionCore {
  public:
   virtual ~FusionCore() = default;
@@ -49,6 +60,13 @@ class FusionCore {
   virtual void add_imu(const ImuSample& sample, std::vector<NavState>& states) = 0;
   /// One lidar scan; its pool buffer returns when the core drops the scan. Appends states.
   virtual void add_scan(LidarScan scan, std::vector<NavState>& states) = 0;
+  /// One camera frame (stamp on the host clock); its pool buffer returns when the core drops
+  /// the image. A core without a visual front end drops it at once.
+  virtual void add_image(CameraStream stream, Image image, std::vector<NavState>& states) {
+    (void)stream;
+    (void)image;
+    (void)states;
+  }
   virtual EstimatorMode mode() const = 0;
   /// one line for the summary and logs, e.g. "strapdown (IMU-only dead reckoning ...)"
   virtual std::string_view description() const = 0;
@@ -56,6 +74,11 @@ class FusionCore {
   /// Appends the map and keyframe poses built so far; cores without a map (IMU-only) add
   /// nothing, and so does a core not asked to keep one (LioConfig::keep_map).
   virtual void export_map(MapExport& out) const { (void)out; }
+  /// The newest matched scan; false for a core without a lidar or before its first match.
+  virtual bool latest_matched_scan(MatchedScan& out) const {
+    (void)out;
+    return false;
+  }
 };
 
 /// IMU-only dead reckoning (Strapdown): the core for configurations without aiding sensors.

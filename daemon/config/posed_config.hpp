@@ -76,17 +76,19 @@ struct LidarSection {
 struct CameraSection {
   bool enabled = false;
   std::string device;                     ///< V4L2 path, /dev/v4l/by-id/..., or serial
+  std::string source;                     ///< v4l2 | aravis
+  std::string format;                     ///< wire pixel format (yuyv, y8, y16, mjpeg, ...)
   int width = 0;                          ///< [px]
   int height = 0;                         ///< [px]
   double rate_hz = 0;                     ///< [Hz]
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics [px]
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  ///< radial-tangential distortion
-  double latency_s = 0;    ///< host arrival minus exposure midpoint, for clockless streams [s]
+  double latency_s = 0;    ///< least host arrival minus exposure midpoint of a frame [s]
   std::string clock_kind;  ///< hardware_ns (D435i metadata) | none (UVC thermal)
 };
 
 struct SyncSection {
-  double pairing_tolerance_s = 0.01;  ///< visible/thermal frames further apart are not paired [s]
+  double pairing_tolerance_s = 0.02;  ///< visible/thermal frames further apart are not paired [s]
 };
 
 struct ExtrinsicsSection {
@@ -125,12 +127,14 @@ struct ThreadsSection {
   ThreadSection imu_source;
   ThreadSection lidar_source;
   ThreadSection fusion;
+  ThreadSection camera_source;
   ThreadSection publisher;
 };
 
 struct QueuesSection {
   int imu_capacity = 1024;    ///< IMU samples between the IMU source and the fusion core
   int scan_capacity = 4;      ///< lidar scans between the lidar source and the fusion core
+  int image_capacity = 4;     ///< frames per camera between its source and the fusion core
   int state_capacity = 1024;  ///< propagated states between the fusion core and the publisher
 };
 

@@ -9,6 +9,7 @@ namespace posed::pipeline {
 namespace {
 HostTime stamp_of(const ImuItem& item) { return item.sample.stamp; }
 HostTime stamp_of(const ScanItem& item) { return item.scan.end_stamp; }
+HostTime stamp_of(const ImageItem& item) { return item.image.stamp; }
 }  // namespace
 
 // One input stream with a one-item look-ahead, so the merge can compare heads without popping.
@@ -28,6 +29,8 @@ class FusionStage::Lane {
     }
   }
   bool has_head() const { return head_.has_value(); }
+  /// stamp order must wait for this lane: it has no head yet but more may come
+  bool waiting() const { return !head_ && !end_seen_; }
   /// no head and none to come
   bool ended() const { return end_seen_ && !head_; }
   HostTime head_stamp() const { return stamp_of(*head_); }
@@ -72,34 +75,64 @@ void FusionStage::run() {
   apply_thread_policy("posed-fusion", config_.threads.fusion);
   Lane<ImuItem> imu(inputs_.imu);
   Lane<ScanItem> scans(inputs_.scans);
+  Lane<ImageItem> visible(inputs_.visible);
+  Lane<ImageItem> thermal(inputs_.thermal);
 
-  // Which lane goes next: the oldest head; IMU first on equal stamps, so a scan ending exactly at
-  // an IMU sample finds it already in the core. Stamp order waits for every open lane.
-  enum class Next { kNone, kImu, kScan };
+  // Which lane goes next: the oldest head; on equal stamps the IMU first (a scan or frame ending
+  // exactly at an IMU sample finds it already in the core), then scans, visible, thermal. Stamp
+  // order waits for every open lane.
+  enum class Next { kNone, kImu, kScan, kVisible, kThermal };
   const auto next = [&] {
     imu.refill();
     scans.refill();
+    visible.refill();
+    thermal.refill();
     if (in_stamp_order_ &&
-        ((!imu.has_head() && !imu.ended()) || (!scans.has_head() && !scans.ended()))) {
+        (imu.waiting() || scans.waiting() || visible.waiting() || thermal.waiting())) {
       return Next::kNone;
     }
-    if (imu.has_head() && (!scans.has_head() || imu.head_stamp() <= scans.head_stamp())) {
-      return Next::kImu;
-    }
-    return scans.has_head() ? Next::kScan : Next::kNone;
+    Next best = Next::kNone;
+    HostTime best_stamp;
+    const auto consider = [&](const auto& lane, Next which) {
+      if (lane.has_head() && (best == Next::kNone || lane.head_stamp() < best_stamp)) {
+        best = which;
+        best_stamp = lane.head_stamp();
+      }
+    };
+    consider(imu, Next::kImu);
+    consider(scans, Next::kScan);
+    consider(visible, Next::kVisible);
+    consider(thermal, Next::kThermal);
+    return best;
+  };
+  const auto all_ended = [&] {
+    return imu.ended() && scans.ended() && visible.ended() && thermal.ended();
   };
 
   std::uint64_t handed_since_figures = 0;
-  while (!imu.ended() || !scans.ended()) {
+  while (!all_ended()) {
     heartbeat_.beat();
     bool handed = false;
     for (Next n = next(); n != Next::kNone; n = next()) {
       heartbeat_.beat();  // a backlog can take a while; the watchdog must see the stage alive
-      if (n == Next::kImu) {
-        core_->add_imu(imu.take().sample, produced_);
-      } else {
-        core_->add_scan(scans.take().scan, produced_);
-        counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);
+      switch (n) {
+        case Next::kImu:
+          core_->add_imu(imu.take().sample, produced_);
+          break;
+        case Next::kScan:
+          core_->add_scan(scans.take().scan, produced_);
+          counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);
+          break;
+        case Next::kVisible:
+          core_->add_image(CameraStream::kVisible, visible.take().image, produced_);
+          counters_.frames_fused[0].fetch_add(1, std::memory_order_relaxed);
+          break;
+        case Next::kThermal:
+          core_->add_image(CameraStream::kThermal, thermal.take().image, produced_);
+          counters_.frames_fused[1].fetch_add(1, std::memory_order_relaxed);
+          break;
+        case Next::kNone:
+          break;
       }
       counters_.mode.store(core_->mode(), std::memory_order_relaxed);
       handed = true;

@@ -2,7 +2,8 @@
 // The fusion stage (one thread): merges the measurement queues and drives the FusionCore
 // (core/estimator/fusion_core.hpp), whose states go to the publisher's queue.
 //
-// Order. Each queue delivers its stream in stamp order (IMU sample stamp, scan end stamp). With
+// Order. Each queue delivers its stream in stamp order (IMU sample stamp, scan end stamp, frame
+// exposure stamp). With
 // recordings as Sources (`in_stamp_order`), the stage merges the streams by stamp: it hands the
 // core the oldest head only once every stream that has not ended has a head to compare with —
 // a k-way merge that waits for the slowest stream. The core then sees one order, a function of
@@ -27,6 +28,8 @@ namespace posed::pipeline {
 struct FusionCounters {
   std::atomic<std::uint64_t> states{0};       ///< states the core produced
   std::atomic<std::uint64_t> scans_fused{0};  ///< scans handed to the core
+  /// camera frames handed to the core, by CameraStream
+  std::atomic<std::uint64_t> frames_fused[2] = {0, 0};
   std::atomic<EstimatorMode> mode{EstimatorMode::kAligning};
 
   void publish_figures(const FusionFigures& f) {
@@ -44,8 +47,10 @@ struct FusionCounters {
 };
 
 struct FusionInputs {
-  SpscQueue<ImuItem>* imu = nullptr;     ///< required
-  SpscQueue<ScanItem>* scans = nullptr;  ///< null without a lidar
+  SpscQueue<ImuItem>* imu = nullptr;        ///< required
+  SpscQueue<ScanItem>* scans = nullptr;     ///< null without a lidar
+  SpscQueue<ImageItem>* visible = nullptr;  ///< null without the visible camera
+  SpscQueue<ImageItem>* thermal = nullptr;  ///< null without the thermal camera
 };
 
 class FusionStage {

@@ -4,6 +4,7 @@
 
 #include "core/estimator/fusion_core.hpp"
 #include "core/estimator/lio_estimator.hpp"
+#include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/estimator_config.hpp"
 #include "daemon/pipeline/fusion_stage.hpp"
 #include "daemon/pipeline/imu_stage.hpp"
@@ -16,6 +17,10 @@
 namespace posed::pipeline {
 
 namespace {
+
+constexpr CameraStream kCameraStreams[] = {CameraStream::kVisible, CameraStream::kThermal};
+std::size_t index_of(CameraStream s) { return static_cast<std::size_t>(s); }
+std::string stage_name(CameraStream s) { return std::string(to_string(s)) + "_source"; }
 
 std::chrono::nanoseconds block_timeout(const drivers::Source* source) {
   return source && !source->live() ? std::chrono::nanoseconds(kReplayBlockTimeout)
@@ -51,9 +56,19 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
         static_cast<std::size_t>(config.queues.scan_capacity), queue_policy(sources_.lidar.get()),
         block_timeout(sources_.lidar.get()));
   }
+  for (const CameraStream s : kCameraStreams) {
+    const drivers::Source* source = sources_.camera(s).get();
+    if (source == nullptr) continue;
+    image_queues_[index_of(s)] = std::make_unique<SpscQueue<ImageItem>>(
+        static_cast<std::size_t>(config.queues.image_capacity), queue_policy(source),
+        block_timeout(source));
+  }
   // The order of stage_names(): what the watchdog and the summary list.
   add_stage("imu_source");
   if (sources_.lidar) add_stage("lidar_source");
+  for (const CameraStream s : kCameraStreams) {
+    if (sources_.camera(s)) add_stage(stage_name(s));
+  }
   add_stage("fusion");
   add_stage("publisher");
 }
@@ -105,12 +120,24 @@ bool Pipeline::start(std::string& error) {
                                                 *scan_queue_, fusion_ready_, *heartbeats_[stage++],
                                                 lidar_counters_, *scan_counters_);
   }
+  for (const CameraStream s : kCameraStreams) {
+    if (!sources_.camera(s)) continue;
+    const std::size_t i = index_of(s);
+    camera_stages_[i] =
+        std::make_unique<CameraStage>(config_, s, *sources_.camera(s), *image_queues_[i],
+                                      fusion_ready_, *heartbeats_[stage++], camera_counters_[i]);
+  }
   // Recordings and generators at full speed: merge by stamp so replays are deterministic.
-  const bool in_stamp_order = !sources_.imu->live() && (!sources_.lidar || !sources_.lidar->live());
+  bool in_stamp_order = !sources_.imu->live();
+  for (const drivers::Source* s :
+       {sources_.lidar.get(), sources_.visible.get(), sources_.thermal.get()}) {
+    if (s != nullptr && s->live()) in_stamp_order = false;
+  }
   fusion_stage_ = std::make_unique<FusionStage>(
       config_, make_core(config_, sources_.lidar != nullptr, outputs_.keep_map),
-      FusionInputs{&imu_queue_, scan_queue_.get()}, in_stamp_order, state_queue_, fusion_ready_,
-      state_ready_, *heartbeats_[stage++], *fusion_counters_);
+      FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get()},
+      in_stamp_order, state_queue_, fusion_ready_, state_ready_, *heartbeats_[stage++],
+      *fusion_counters_);
   publisher_stage_ = std::make_unique<PublisherStage>(
       config_, state_queue_, state_ready_, *heartbeats_[stage++], outputs_.on_state,
       outputs_.on_status, [this] { return status(); });
@@ -120,6 +147,14 @@ bool Pipeline::start(std::string& error) {
     if (!sources_.lidar->open(lidar_error)) {
       POSED_LOG_WARN("lidar source not open yet: %s; retrying in the background",
                      lidar_error.c_str());
+    }
+  }
+  for (const CameraStream s : kCameraStreams) {
+    if (!sources_.camera(s)) continue;
+    std::string camera_error;
+    if (!sources_.camera(s)->open(camera_error)) {
+      POSED_LOG_WARN("%s camera source not open yet: %s; retrying in the background",
+                     to_string(s).data(), camera_error.c_str());
     }
   }
   std::string open_error;
@@ -132,6 +167,9 @@ bool Pipeline::start(std::string& error) {
   started_ = true;
   launch([this] { imu_stage_->run(); });
   if (lidar_stage_) launch([this] { lidar_stage_->run(); });
+  for (auto& camera : camera_stages_) {
+    if (camera) launch([stage = camera.get()] { stage->run(); });
+  }
   launch([this] { fusion_stage_->run(); });
   launch([this] { publisher_stage_->run(); });
   return true;
@@ -140,6 +178,8 @@ bool Pipeline::start(std::string& error) {
 void Pipeline::request_stop() {
   if (sources_.imu) sources_.imu->request_stop();
   if (sources_.lidar) sources_.lidar->request_stop();
+  if (sources_.visible) sources_.visible->request_stop();
+  if (sources_.thermal) sources_.thermal->request_stop();
 }
 
 void Pipeline::join() {
@@ -180,6 +220,14 @@ PipelineStatus Pipeline::status() const {
     st.lidar_scans = scan_counters_->scans.load();
     st.lidar_points = scan_counters_->points.load();
     st.lidar_scans_fused = fusion_counters_->scans_fused.load();
+  }
+  for (const CameraStream s : kCameraStreams) {
+    if (!sources_.camera(s)) continue;
+    StreamStatus camera;
+    camera.name = std::string(to_string(s));
+    fill_stream_status(camera, camera_counters_[index_of(s)], now, sources_.camera(s)->live());
+    st.streams.push_back(std::move(camera));
+    st.camera_frames_fused[index_of(s)] = fusion_counters_->frames_fused[index_of(s)].load();
   }
   return st;
 }

@@ -4,6 +4,7 @@
 // they differ only in the Sources passed in. Each stage lives in its own file:
 //   imu_stage      Source -> A9 decoder -> ClockSync -> IMU queue
 //   lidar_stage    Source -> Velodyne decoder -> ClockSync -> scan assembler -> scan queue
+//   camera_stage   Source -> frame decoder -> camera clock -> image queue (visible, thermal)
 //   fusion_stage   merge of the measurement queues -> FusionCore -> state queue
 //   publisher_stage  states -> on_state, status snapshots -> on_status
 //
@@ -31,6 +32,7 @@ namespace posed::pipeline {
 
 class ImuStage;
 class LidarStage;
+class CameraStage;
 class FusionStage;
 class PublisherStage;
 struct LidarScanCounters;
@@ -41,6 +43,18 @@ struct PipelineSources {
   std::unique_ptr<drivers::Source> imu;
   /// VLP-32C UDP payloads, channel 0 data, 1 position (live UDP, pcap, or replayed); optional
   std::unique_ptr<drivers::Source> lidar;
+  /// D435i colour frames (channel 0) and their D4xx metadata (channel 1); optional
+  std::unique_ptr<drivers::Source> visible;
+  /// PLUG 617 thermal frames (channel 0); optional
+  std::unique_ptr<drivers::Source> thermal;
+
+  /// The camera Source of a stream (null when absent).
+  std::unique_ptr<drivers::Source>& camera(CameraStream s) {
+    return s == CameraStream::kVisible ? visible : thermal;
+  }
+  const drivers::Source* camera(CameraStream s) const {
+    return s == CameraStream::kVisible ? visible.get() : thermal.get();
+  }
 };
 
 /// Callbacks run on the publisher thread.
@@ -55,7 +69,7 @@ struct PipelineOutputs {
 
 /// One stage's last sign of life, for the systemd watchdog.
 struct StageBeat {
-  std::string name;  ///< "imu_source", "lidar_source", "fusion", "publisher"
+  std::string name;  ///< "imu_source", "lidar_source", "visible_source", "fusion", "publisher"
   HostTime last;
 };
 
@@ -96,6 +110,8 @@ class Pipeline {
   PipelineOutputs outputs_;
   SpscQueue<ImuItem> imu_queue_;
   std::unique_ptr<SpscQueue<ScanItem>> scan_queue_;
+  /// per CameraStream; null without that camera
+  std::unique_ptr<SpscQueue<ImageItem>> image_queues_[2];
   SpscQueue<StateItem> state_queue_;
   /// signalled by every source stage: the fusion stage has input
   Wakeup fusion_ready_;
@@ -103,12 +119,14 @@ class Pipeline {
 
   StreamCounters imu_counters_;
   StreamCounters lidar_counters_;
+  StreamCounters camera_counters_[2];
   std::unique_ptr<LidarScanCounters> scan_counters_;
   std::unique_ptr<FusionCounters> fusion_counters_;
   std::vector<std::unique_ptr<Heartbeat>> heartbeats_;
 
   std::unique_ptr<ImuStage> imu_stage_;
   std::unique_ptr<LidarStage> lidar_stage_;
+  std::unique_ptr<CameraStage> camera_stages_[2];
   std::unique_ptr<FusionStage> fusion_stage_;
   std::unique_ptr<PublisherStage> publisher_stage_;
   bool started_ = false;

@@ -34,6 +34,8 @@ struct PipelineStatus {
   std::uint64_t lidar_scans = 0;        ///< scans assembled
   std::uint64_t lidar_points = 0;       ///< points in those scans
   std::uint64_t lidar_scans_fused = 0;  ///< scans the fusion core received
+  /// camera frames the fusion core received, by CameraStream (visible, thermal)
+  std::uint64_t camera_frames_fused[2] = {0, 0};
   /// the estimator's own figures (scans used, degeneracy, biases, re-initialisations)
   FusionFigures estimator;
   std::uint64_t states = 0;          ///< states produced by the fusion core

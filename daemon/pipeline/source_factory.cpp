@@ -1,5 +1,10 @@
 #include "daemon/pipeline/source_factory.hpp"
 
+#include <cmath>
+
+#include "daemon/pipeline/camera_stage.hpp"
+#include "drivers/camera/aravis_source.hpp"
+#include "drivers/camera/v4l2_source.hpp"
 #include "drivers/imu/serial_source.hpp"
 #include "drivers/recording/pcap_source.hpp"
 #include "drivers/velodyne/udp_source.hpp"
@@ -21,6 +26,55 @@ drivers::SyntheticImuConfig synthetic_imu_config(const config::PosedConfig& conf
   return c;
 }
 
+namespace {
+
+/// The live Source of an enabled camera: GenICam through Aravis (device = camera id) or V4L2.
+bool make_camera_source(const config::PosedConfig& config, CameraStream stream,
+                        PipelineSources& sources, std::string& error) {
+  const config::CameraSection& section = camera_section(config, stream);
+  if (!section.enabled) return true;
+  const std::string name(to_string(stream));
+  const auto format = drivers::camera::wire_format_from_string(section.format);
+  if (!format) {
+    // The schema admits only known names; this guards a new one not wired here.
+    error = name + "_camera.format '" + section.format + "' has no decoder";
+    return false;
+  }
+  if (section.source == "aravis") {
+    drivers::camera::AravisConfig a;
+    a.camera_id = section.device;
+    if (*format == drivers::camera::WireFormat::kY8) {
+      a.pixel_format = "Mono8";
+    } else if (*format == drivers::camera::WireFormat::kY16) {
+      a.pixel_format = "Mono16";
+    } else {
+      error = name + "_camera.format '" + section.format +
+              "' is not a GenICam format posed reads (y8 = Mono8, y16 = Mono16)";
+      return false;
+    }
+    a.width = static_cast<std::uint32_t>(section.width);
+    a.height = static_cast<std::uint32_t>(section.height);
+    a.frame_rate_hz = section.rate_hz;
+    sources.camera(stream) = std::make_unique<drivers::camera::AravisSource>(name, std::move(a));
+    return true;
+  }
+  if (section.device.empty()) {
+    error = name + "_camera.enabled is true but " + name + "_camera.device is empty";
+    return false;
+  }
+  drivers::camera::V4l2CaptureConfig v;
+  v.device = section.device;
+  v.format = *format;
+  v.width = static_cast<std::uint32_t>(section.width);
+  v.height = static_cast<std::uint32_t>(section.height);
+  v.fps = static_cast<std::uint32_t>(std::lround(section.rate_hz));
+  sources.camera(stream) = std::make_unique<drivers::camera::V4l2Source>(
+      name, drivers::camera::system_v4l2_device(), std::move(v));
+  return true;
+}
+
+}  // namespace
+
 BuiltSources make_sources(const config::PosedConfig& config, std::string& error) {
   BuiltSources built;
   if (config.imu.source == "synthetic") {
@@ -36,7 +90,14 @@ BuiltSources make_sources(const config::PosedConfig& config, std::string& error)
     // The schema only admits the values above; this guards against a new one not wired here.
     error = "imu.source '" + config.imu.source + "' has no Source in make_sources()";
   }
-  if (!error.empty() || !config.lidar.enabled) return built;
+  if (!error.empty()) return built;
+  for (const CameraStream stream : {CameraStream::kVisible, CameraStream::kThermal}) {
+    if (!make_camera_source(config, stream, built.sources, error)) {
+      built.sources = {};
+      return built;
+    }
+  }
+  if (!config.lidar.enabled) return built;
   if (config.lidar.source == "udp") {
     drivers::velodyne::UdpSourceConfig udp;
     udp.sensor_address = config.lidar.address;

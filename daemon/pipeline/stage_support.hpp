@@ -34,6 +34,10 @@ struct ScanItem {
   LidarScan scan;
   bool end_of_stream = false;
 };
+struct ImageItem {
+  Image image;
+  bool end_of_stream = false;
+};
 struct StateItem {
   NavState state;
   bool end_of_stream = false;

@@ -127,7 +127,8 @@ bool Recorder::push(std::uint16_t id, std::int64_t log_time_ns, std::vector<std:
   if (!open_ || id >= channel_count_.load(std::memory_order_acquire)) return false;
   Channel& c = *channels_[id];
   const std::size_t size = bytes.size();
-  const PushResult r = c.queue.push(Item{log_time_ns, std::move(bytes)});
+  const std::uint64_t order = push_order_.fetch_add(1, std::memory_order_relaxed);
+  const PushResult r = c.queue.push(Item{log_time_ns, order, std::move(bytes)});
   if (r != PushResult::kPushed) return false;
   c.bytes.store(c.bytes.load(std::memory_order_relaxed) + size, std::memory_order_relaxed);
   return true;
@@ -179,6 +180,7 @@ void Recorder::rotate() {
 void Recorder::run() {
   struct Pending {
     std::int64_t log_time_ns;
+    std::uint64_t order;
     std::uint16_t channel;
     std::vector<std::byte> bytes;
   };
@@ -194,13 +196,16 @@ void Recorder::run() {
       Item item;
       // Bounded per pass so one busy channel cannot starve the merge order of the others.
       for (int k = 0; k < 4096 && channels_[i]->queue.try_pop(item); ++k) {
-        batch.push_back({item.log_time_ns, static_cast<std::uint16_t>(i), std::move(item.bytes)});
+        batch.push_back(
+            {item.log_time_ns, item.order, static_cast<std::uint16_t>(i), std::move(item.bytes)});
       }
     }
     // Queues are drained in batches; ordering each batch by log time keeps the file close to
-    // time order across channels (MCAP does not require it; players prefer it).
-    std::stable_sort(batch.begin(), batch.end(), [](const Pending& a, const Pending& b) {
-      return a.log_time_ns < b.log_time_ns;
+    // time order across channels (MCAP does not require it; players prefer it). Equal log times
+    // keep the order they were pushed in: a Source's chunks of one read (a D435i frame's metadata,
+    // then the frame) must replay in that order whatever channel each went to.
+    std::sort(batch.begin(), batch.end(), [](const Pending& a, const Pending& b) {
+      return a.log_time_ns != b.log_time_ns ? a.log_time_ns < b.log_time_ns : a.order < b.order;
     });
     for (auto& p : batch) {
       if (!writer_.is_open()) {

@@ -113,6 +113,8 @@ class Recorder {
   enum class Kind : std::uint8_t { kRaw, kPose, kOdometry };
   struct Item {
     std::int64_t log_time_ns = 0;
+    /// order of push() across all channels: breaks log-time ties as the producers wrote them
+    std::uint64_t order = 0;
     std::vector<std::byte> bytes;
   };
   struct Channel {
@@ -146,6 +148,7 @@ class Recorder {
 
   std::array<std::unique_ptr<Channel>, kMaxChannels> channels_;
   std::atomic<std::size_t> channel_count_{0};
+  std::atomic<std::uint64_t> push_order_{0};
   mutable std::mutex mutex_;  // channel registration, topic lookup, files_, error_
   std::map<std::string, std::uint16_t, std::less<>> pose_topics_;
   std::vector<std::string> files_;

@@ -127,6 +127,8 @@ constexpr std::array kKinds = {
     InspectKind{"a9", "Handsfree A9 IMU raw serial bytes", inspect_a9},
     InspectKind{"velodyne", "Velodyne VLP-32C/VLP-16/HDL-32E pcap or pcapng", run_inspect_velodyne},
     InspectKind{"mcap", "MCAP recording: channels, counts, rates, gaps, errors", run_inspect_mcap},
+    InspectKind{"camera", "cameras: --list (V4L2, GenICam), or capture N frames to PNG",
+                run_inspect_camera},
 };
 
 void print_usage(std::FILE* out) {

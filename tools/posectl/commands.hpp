@@ -18,6 +18,7 @@ std::span<const Command> commands();
 int run_bench(int argc, char** argv);
 int run_inspect(int argc, char** argv);
 int run_inspect_velodyne(int argc, char** argv);
+int run_inspect_camera(int argc, char** argv);
 int run_echo(int argc, char** argv);
 int run_eval(int argc, char** argv);
 int run_sim(int argc, char** argv);

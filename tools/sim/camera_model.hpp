@@ -93,8 +93,10 @@ class VisibleCamera {
   /// Renders the next frame as YUYV (width·height·2 bytes) into `out`.
   void emit(std::vector<std::byte>& out);
   std::uint64_t frames() const { return index_; }
-  /// current auto-exposure gain [x]
+  /// current auto-exposure gain [x]: the amplification the next frame is exposed with
   double gain() const { return gain_; }
+  /// the next frame's exposure midpoint on the camera's own clock
+  DeviceTime next_exposure_mid() const { return exposure_mid(index_); }
 
  private:
   DeviceTime exposure_mid(std::uint64_t k) const;

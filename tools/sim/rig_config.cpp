@@ -31,6 +31,7 @@ SimRig rig_from_config(const config::PosedConfig& cfg) {
   rig.thermal = to_intrinsics(cfg.thermal_camera);
   rig.thermal_rate_hz = cfg.thermal_camera.rate_hz;
   rig.thermal_latency_s = cfg.thermal_camera.latency_s;
+  rig.visible_latency_s = cfg.visible_camera.latency_s;
   return rig;
 }
 

@@ -6,10 +6,12 @@
 #include <queue>
 #include <random>
 
+#include "drivers/common/wire_format.hpp"
 #include "drivers/recording/raw_channels.hpp"
 #include "drivers/velodyne/packet_format.hpp"
 #include "drivers/velodyne/position_packet.hpp"
 #include "tools/sim/bvh.hpp"
+#include "tools/sim/d4xx_metadata_encoder.hpp"
 #include "tools/sim/lidar_model.hpp"
 #include "tools/sim/scenarios.hpp"
 
@@ -44,6 +46,30 @@ std::map<std::string, std::string> clock_metadata(const ClockModelConfig& c, boo
           {"sim.jitter_mean_ns", std::to_string(c.jitter_mean_ns)}};
 }
 
+/// What the D435i reports about the next visible frame. Its auto-exposure is modelled as one
+/// amplification (VisibleCamera::gain); reported as the real one splits it: exposure first, up
+/// to half the frame interval, then analog gain (64 = 1x).
+D4xxFrameFacts visible_metadata(const VisibleCamera& camera, const SimRig& rig, HostTime arrival) {
+  D4xxFrameFacts f;
+  const double interval_us = 1e6 / rig.visible_rate_hz;
+  const double max_exposure_us = interval_us / 2;
+  const double exposure_us = max_exposure_us * std::min(camera.gain(), 1.0);
+  const std::int64_t mid_us = camera.next_exposure_mid().ns / 1000;
+  f.frame_counter = static_cast<std::uint32_t>(camera.frames());
+  f.sensor_timestamp_us = static_cast<std::uint32_t>(mid_us);  // the device counter wraps
+  f.pts_us = static_cast<std::uint32_t>(mid_us - std::llround(exposure_us / 2));
+  f.exposure_time_us = static_cast<std::uint32_t>(std::llround(exposure_us));
+  f.frame_interval_us = static_cast<std::uint32_t>(std::llround(interval_us));
+  f.gain = static_cast<std::uint32_t>(std::llround(64 * std::max(camera.gain(), 1.0)));
+  f.width_px = static_cast<std::uint16_t>(rig.visible.width);
+  f.height_px = static_cast<std::uint16_t>(rig.visible.height);
+  f.fps = static_cast<std::uint16_t>(std::lround(rig.visible_rate_hz));
+  // uvc_meta_buf.ns: the frame's first USB packet, about half a frame interval before the last.
+  f.host_sof_ns = static_cast<std::uint64_t>(arrival.ns - std::llround(interval_us * 500));
+  f.usb_sof = static_cast<std::uint16_t>((f.host_sof_ns / 1'000'000) & 0x7FF);
+  return f;
+}
+
 /// Per-device clocks for a seed (offsets, drifts tens of ppm) and transports.
 struct Clocks {
   ClockModelConfig lidar, imu, visible, thermal;
@@ -57,7 +83,12 @@ Clocks make_clocks(std::mt19937_64& rng, const SimRig& rig, bool noise) {
   // A9: µs since power-on, anywhere in its 71.6 min wrap (some runs wrap).
   c.imu = {static_cast<std::int64_t>(u(1.0, 4294.0) * 1e9), u(-50, 50), 600'000, 300'000};
   // D435i: hardware clock since power-on; frame readout and USB transfer.
-  c.visible = {static_cast<std::int64_t>(u(1.0, 1e4) * 1e9), u(-30, 30), 8'000'000, 2'000'000};
+  // A frame is sent once read out, half a frame after its exposure midpoint (VisibleCamera);
+  // the rest of the configured latency is the USB transfer.
+  const double visible_transfer_s =
+      std::max(rig.visible_latency_s - 0.5 / rig.visible_rate_hz, 1e-3);
+  c.visible = {static_cast<std::int64_t>(u(1.0, 1e4) * 1e9), u(-30, 30),
+               static_cast<std::int64_t>(visible_transfer_s * 1e9), 2'000'000};
   // Thermal: no clock; its frame oscillator still drifts; stamped on arrival.
   c.thermal = {0, u(-100, 100), static_cast<std::int64_t>(rig.thermal_latency_s * 1e9), 3'000'000};
   if (!noise) {
@@ -127,7 +158,7 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
 
   // Streams, named as the daemon's Sources name them (raw_channels.hpp).
   const std::string scen = "sim " + options.scenario + " seed " + std::to_string(options.seed);
-  int s_imu = -1, s_lidar = -1, s_pos = -1, s_vis = -1, s_th = -1;
+  int s_imu = -1, s_lidar = -1, s_pos = -1, s_vis = -1, s_vis_meta = -1, s_th = -1;
   if (options.imu) {
     auto md = clock_metadata(clocks.imu, true);
     md["rate_hz"] = num(rig.imu.rate_hz);
@@ -151,14 +182,18 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
     md["device"] = scen;
     return md;
   };
-  if (options.visible_camera)
-    s_vis = sink.add_stream(
-        {"visible", "yuyv", 0, camera_md(rig.visible, rig.visible_rate_hz, clocks.visible, true)});
+  if (options.visible_camera) {
+    const auto md = camera_md(rig.visible, rig.visible_rate_hz, clocks.visible, true);
+    s_vis = sink.add_stream({"visible", "yuyv", 0, md});
+    // The D435i's frame metadata, on the Source channel the V4L2 Source gives it.
+    s_vis_meta = sink.add_stream({"visible", std::string(drivers::wire::kUvcMetaD4xx), 1, md});
+  }
   if (options.thermal_camera)
     s_th = sink.add_stream(
         {"thermal", "y8", 0, camera_md(rig.thermal, rig.thermal_rate_hz, clocks.thermal, false)});
   if ((options.imu && s_imu < 0) || (options.lidar && (s_lidar < 0 || s_pos < 0)) ||
-      (options.visible_camera && s_vis < 0) || (options.thermal_camera && s_th < 0)) {
+      (options.visible_camera && (s_vis < 0 || s_vis_meta < 0)) ||
+      (options.thermal_camera && s_th < 0)) {
     error = "the sink refused a stream";
     return false;
   }
@@ -238,9 +273,14 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
     if (options.visible_camera) {
       while (visible.next_send() < w1) {
         const Duration sent = visible.next_send();
+        // The metadata buffer completes with the frame and is read just before it.
+        const HostTime arrival = vis_clock.arrival(sent);
+        std::vector<std::byte> metadata;
+        encode_d4xx_metadata(visible_metadata(visible, rig, arrival), metadata);
+        push(arrival.ns, s_vis_meta, std::move(metadata));
         std::vector<std::byte> bytes;
         visible.emit(bytes);
-        push(vis_clock.arrival(sent).ns, s_vis, std::move(bytes));
+        push(arrival.ns, s_vis, std::move(bytes));
         ++summary.visible_frames;
       }
     }

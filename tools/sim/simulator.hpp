@@ -46,6 +46,8 @@ struct SimRig {
   double thermal_rate_hz = 25.0;
   /// host arrival minus exposure for the clockless thermal camera [s]
   double thermal_latency_s = 0.03;
+  /// least host arrival minus exposure midpoint of a colour frame: readout plus USB [s]
+  double visible_latency_s = 0.041;
 };
 
 struct SimOptions {

@@ -1,0 +1,108 @@
+#include "daemon/pipeline/camera_stage.hpp"
+
+#include <algorithm>
+
+#include "daemon/pipeline/thread_policy.hpp"
+#include "drivers/common/log.hpp"
+#include "drivers/common/wire_format.hpp"
+
+namespace posed::pipeline {
+
+namespace camera = drivers::camera;
+
+const config::CameraSection& camera_section(const config::PosedConfig& config, CameraStream s) {
+  return s == CameraStream::kVisible ? config.visible_camera : config.thermal_camera;
+}
+
+std::size_t CameraStage::pool_buffers(const config::PosedConfig& config) {
+  return static_cast<std::size_t>(config.queues.image_capacity) + 4;
+}
+
+std::size_t CameraStage::frame_bytes(const config::CameraSection& section) {
+  // Colour decodes to 3 bytes per pixel and raw thermal/depth to 2; a buffer sized for colour
+  // holds any format the stream can switch to (a recording's channel decides, not the config).
+  return static_cast<std::size_t>(section.width) * static_cast<std::size_t>(section.height) * 3;
+}
+
+CameraStage::CameraStage(const config::PosedConfig& config, CameraStream stream,
+                         drivers::Source& source, SpscQueue<ImageItem>& queue, Wakeup& consumer,
+                         Heartbeat& heartbeat, StreamCounters& counters)
+    : config_(config),
+      stream_(stream),
+      section_(camera_section(config, stream)),
+      source_(source),
+      queue_(queue),
+      consumer_(consumer),
+      heartbeat_(heartbeat),
+      counters_(counters),
+      pool_(pool_buffers(config), frame_bytes(section_)),
+      clock_(section_) {}
+
+camera::FrameDecoder* CameraStage::decoder_for(std::string_view wire_format) {
+  if (decoder_ && wire_format == decoder_format_) return decoder_.get();
+  const std::optional<camera::WireFormat> format = camera::wire_format_from_string(wire_format);
+  if (!format) return nullptr;
+  camera::FrameDecoderConfig c;
+  c.format = *format;
+  c.width = static_cast<std::uint32_t>(section_.width);
+  c.height = static_cast<std::uint32_t>(section_.height);
+  // A thermal camera's MJPEG is grey; the fusion core's thermal path wants one channel.
+  c.mjpeg_to_mono8 = stream_ == CameraStream::kThermal;
+  decoder_ = std::make_unique<camera::FrameDecoder>(c);
+  decoder_format_ = std::string(wire_format);
+  return decoder_.get();
+}
+
+void CameraStage::handle_frame(const drivers::RawChunk& chunk, camera::FrameDecoder& decoder) {
+  Image image;
+  const camera::DecodeStatus status = decoder.decode(chunk.bytes, sequence_++, pool_, image);
+  // The frame is stamped even when it cannot be decoded: the clock must see every arrival.
+  const HostTime stamp = clock_.stamp(chunk.host_receive);
+  log_clock_event(to_string(stream_), clock_.last_event());
+  switch (status) {
+    case camera::DecodeStatus::kOk:
+    case camera::DecodeStatus::kPartial:
+      break;
+    case camera::DecodeStatus::kPoolEmpty:
+      counters_.dropped.fetch_add(1, std::memory_order_relaxed);
+      return;
+    case camera::DecodeStatus::kPoolTooSmall:
+    case camera::DecodeStatus::kBadFrame:
+      counters_.malformed.fetch_add(1, std::memory_order_relaxed);
+      return;
+  }
+  image.stamp = stamp;
+  counters_.decoded.fetch_add(1, std::memory_order_relaxed);
+  const PushResult r = queue_.push(ImageItem{std::move(image), false});
+  if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
+  consumer_.signal();
+}
+
+void CameraStage::run() {
+  apply_thread_policy(stream_ == CameraStream::kVisible ? "posed-visible" : "posed-thermal",
+                      config_.threads.camera_source);
+  drivers::RawChunk chunk;
+  SourceReader reader(to_string(stream_), source_, heartbeat_, counters_);
+  std::uint64_t frames = 0;
+  while (reader.next(chunk)) {
+    const std::string_view format = reader.wire_format(chunk);
+    if (format == drivers::wire::kUvcMetaD4xx) {
+      if (!clock_.on_metadata(chunk.bytes)) {
+        counters_.malformed.fetch_add(1, std::memory_order_relaxed);
+      }
+      continue;
+    }
+    camera::FrameDecoder* decoder = decoder_for(format);
+    if (decoder == nullptr) {
+      reader.undecodable(chunk);
+      continue;
+    }
+    handle_frame(chunk, *decoder);
+    if (++frames % 16 == 0) counters_.publish_clock(clock_.status());
+  }
+  counters_.publish_clock(clock_.status());
+  queue_.push(ImageItem{{}, true});
+  consumer_.signal();
+}
+
+}  // namespace posed::pipeline
