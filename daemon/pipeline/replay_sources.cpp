@@ -21,11 +21,14 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     while (reader.next(message)) {
     }
   }
-  std::set<std::string> streams;
+  std::set<std::string> streams, raw_streams;  // raw: recorded Source bytes, not imported ros1
   for (const auto& [id, channel] : reader.channels()) {
-    if (channel.message_encoding != recording::raw::kMessageEncoding) continue;
+    if (!recording::raw::is_stream_channel(channel.message_encoding, channel.metadata)) continue;
     const auto it = channel.metadata.find(std::string(recording::raw::kStreamKey));
-    if (it != channel.metadata.end()) streams.insert(it->second);
+    if (it == channel.metadata.end()) continue;
+    streams.insert(it->second);
+    if (channel.message_encoding == recording::raw::kMessageEncoding)
+      raw_streams.insert(it->second);
   }
   for (const auto& record : reader.metadata()) {
     if (record.name != recording::raw::kMetadataName) continue;
@@ -39,8 +42,12 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     }
   }
   if (!streams.count("imu")) {
-    error = options.path + ": no raw IMU stream (/posed/raw/imu) to replay; found: " +
-            (streams.empty() ? std::string("no raw streams") : *streams.begin());
+    std::string found;
+    for (const auto& s : streams) found += (found.empty() ? "" : ", ") + s;
+    error = options.path +
+            ": no IMU stream to replay (/posed/raw/imu, or an imported topic mapped to imu: "
+            "posectl import --topic-map TOPIC=imu); found: " +
+            (found.empty() ? std::string("no streams") : found);
     return out;
   }
 
@@ -57,11 +64,18 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
-  // Cameras replay when recorded; a recording of other streams (a depth camera, a second IMU)
-  // is listed but has no stage to go to.
-  if (streams.count("visible")) out.built.sources.visible = make("visible");
-  if (streams.count("thermal")) out.built.sources.thermal = make("thermal");
-  for (const auto& s : streams) out.streams += (out.streams.empty() ? "" : ", ") + s;
+  // Cameras replay when their raw frames were recorded. Camera topics imported from a ROS 1 bag
+  // (sensor_msgs/Image) have no decoder in the camera stage yet, and other streams (a depth
+  // camera, a second IMU) no stage at all: they are listed, not replayed.
+  const auto replay_camera = [&](const std::string& stream) {
+    return streams.count(stream) != 0 && raw_streams.count(stream) != 0;
+  };
+  if (replay_camera("visible")) out.built.sources.visible = make("visible");
+  if (replay_camera("thermal")) out.built.sources.thermal = make("thermal");
+  for (const auto& s : streams) {
+    const bool replayed = s == "imu" || s == "lidar" || replay_camera(s);
+    out.streams += (out.streams.empty() ? "" : ", ") + s + (replayed ? "" : " (not replayed)");
+  }
   return out;
 }
 

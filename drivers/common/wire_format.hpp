@@ -27,4 +27,16 @@ inline constexpr std::string_view kIioAccel3d = "iio-hid-accel-3d";
 /// the same for a hid-sensor-gyro-3d device (`in_anglvel_*` elements)
 inline constexpr std::string_view kIioGyro3d = "iio-hid-gyro-3d";
 
+// ROS 1 messages imported from a bag (posectl import; docs/import.md): one serialized message
+// per chunk, named "ros1:" + the message type. Decoders: drivers/recording/ros1_messages.hpp.
+inline constexpr std::string_view kRos1Prefix = "ros1:";
+/// sensor_msgs/Imu: angular velocity [rad/s] and specific force [m/s^2], stamped by its header
+inline constexpr std::string_view kRos1Imu = "ros1:sensor_msgs/Imu";
+/// sensor_msgs/PointCloud2 in velodyne_pointcloud's layout (x y z intensity ring time)
+inline constexpr std::string_view kRos1PointCloud2 = "ros1:sensor_msgs/PointCloud2";
+/// sensor_msgs/Image (raw pixels; encoding in the message)
+inline constexpr std::string_view kRos1Image = "ros1:sensor_msgs/Image";
+/// sensor_msgs/CompressedImage (jpeg/png; format in the message)
+inline constexpr std::string_view kRos1CompressedImage = "ros1:sensor_msgs/CompressedImage";
+
 }  // namespace posed::drivers::wire

@@ -23,6 +23,8 @@ std::span<const Command> commands() {
               run_replay},
       Command{"record", "record the raw bytes of the config's live Sources to MCAP (no fusion)",
               run_record},
+      Command{"import", "turn a pcap capture, candump log or ROS 1 bag into a posed recording",
+              run_import},
   };
   return kCommands;
 }

@@ -26,5 +26,6 @@ int run_inspect_mcap(int argc, char** argv);
 int run_export(int argc, char** argv);
 int run_record(int argc, char** argv);
 int run_replay(int argc, char** argv);
+int run_import(int argc, char** argv);
 
 }  // namespace posed::posectl
