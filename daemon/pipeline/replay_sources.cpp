@@ -21,14 +21,12 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     while (reader.next(message)) {
     }
   }
-  std::set<std::string> streams, raw_streams;  // raw: recorded Source bytes, not imported ros1
+  std::set<std::string> streams;
   for (const auto& [id, channel] : reader.channels()) {
     if (!recording::raw::is_stream_channel(channel.message_encoding, channel.metadata)) continue;
     const auto it = channel.metadata.find(std::string(recording::raw::kStreamKey));
     if (it == channel.metadata.end()) continue;
     streams.insert(it->second);
-    if (channel.message_encoding == recording::raw::kMessageEncoding)
-      raw_streams.insert(it->second);
   }
   for (const auto& record : reader.metadata()) {
     if (record.name != recording::raw::kMetadataName) continue;
@@ -64,12 +62,9 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
-  // Cameras replay when their raw frames were recorded. Camera topics imported from a ROS 1 bag
-  // (sensor_msgs/Image) have no decoder in the camera stage yet, and other streams (a depth
-  // camera, a second IMU) no stage at all: they are listed, not replayed.
-  const auto replay_camera = [&](const std::string& stream) {
-    return streams.count(stream) != 0 && raw_streams.count(stream) != 0;
-  };
+  // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp).
+  // Other streams (a depth camera, a second IMU) have no stage: listed, not replayed.
+  const auto replay_camera = [&](const std::string& stream) { return streams.count(stream) != 0; };
   if (replay_camera("visible")) out.built.sources.visible = make("visible");
   if (replay_camera("thermal")) out.built.sources.thermal = make("thermal");
   for (const auto& s : streams) {

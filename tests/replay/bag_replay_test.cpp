@@ -173,7 +173,7 @@ class BagFromSimulation {
          ser::point_cloud2(cloud_seq_++, scan.start_stamp.ns, "velodyne", 1, scan.point_count,
                            ser::velodyne_fields(), ser::kVelodynePointStep, data)});
     ++cloud_count_;
-    // A small colour frame per scan: a stream posed has no stage for yet.
+    // A small colour frame per scan, for the camera stage's sensor_msgs/Image path.
     std::vector<std::byte> rgb(4 * 4 * 3, std::byte{0x80});
     pending_.push_back({arrival, image_,
                         ser::image(cloud_seq_, scan.start_stamp.ns, "camera", 4, 4, "rgb8", rgb)});
@@ -299,6 +299,10 @@ TEST(BagReplay, ASimulatedDriveImportedFromARos1BagIsTrackedInTheBagsTimeBase) {
     EXPECT_NE(posed.out().find("lidar-inertial"), std::string::npos) << posed.out();
     EXPECT_EQ(posed.err().find("no decoder for wire format"), std::string::npos) << posed.err();
     EXPECT_EQ(posed.err().find("malformed"), std::string::npos) << posed.err();
+    // The imported sensor_msgs/Image frames reach the camera stage and decode, every one.
+    const std::string visible_line =
+        "visible             " + std::to_string(converter->clouds()) + " decoded";
+    EXPECT_NE(posed.out().find(visible_line), std::string::npos) << posed.out();
   }
   const eval::Trajectory est = trajectory(poses, "/posed/pose", false);
   const eval::Trajectory gt = trajectory(recording, "/posed/ground_truth", true);
