@@ -1,0 +1,92 @@
+#include "core/vision/image_quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+
+namespace posed::vision {
+
+void weigh(const QualityConfig& config, ImageQuality& quality) {
+  const double omega =
+      config.lambda_n * (quality.noise_sigma + config.lambda_g * (1.0 - quality.gradient_metric));
+  quality.omega = std::clamp(omega, config.omega_min, config.omega_max);
+  quality.confidence = config.omega_min / quality.omega;
+}
+
+QualityAssessor::QualityAssessor(const QualityConfig& config) : config_(config) {}
+
+ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
+  CV_Assert(grey.type() == CV_8UC1 && grey.rows >= 3 && grey.cols >= 3);
+  all_.fill(0);
+  unsaturated_.fill(0);
+  response_.fill(0);
+  const int w = grey.cols, h = grey.rows;
+  gradient_row_.resize(static_cast<std::size_t>(w));
+  response_row_.resize(static_cast<std::size_t>(w));
+  const int low = config_.saturation_low, high = config_.saturation_high;
+  for (int r = 1; r < h - 1; ++r) {
+    const std::uint8_t* up = grey.ptr<std::uint8_t>(r - 1);
+    const std::uint8_t* mid = grey.ptr<std::uint8_t>(r);
+    const std::uint8_t* down = grey.ptr<std::uint8_t>(r + 1);
+    std::uint8_t* g = gradient_row_.data();
+    std::uint16_t* m = response_row_.data();
+    // Sobel and Immerkaer's mask in 16-bit integers, branch-free (vectorised); the histograms in
+    // the scalar loop below.
+    for (int c = 1; c < w - 1; ++c) {
+      const int a = up[c - 1], b = up[c], d = up[c + 1];
+      const int e = mid[c - 1], f = mid[c], k = mid[c + 1];
+      const int p = down[c - 1], q = down[c], s = down[c + 1];
+      const int sx = (d + 2 * k + s) - (a + 2 * e + p);
+      const int sy = (p + 2 * q + s) - (a + 2 * b + d);
+      const int magnitude = (std::abs(sx) + std::abs(sy)) >> 3;
+      g[c] = static_cast<std::uint8_t>(std::min(magnitude, 255));
+      const int laplace = (a + d + p + s) - 2 * (b + e + k + q) + 4 * f;
+      m[c] = static_cast<std::uint16_t>(std::abs(laplace));
+    }
+    for (int c = 1; c < w - 1; ++c) {
+      const std::uint8_t gc = g[c];
+      ++all_[gc];
+      const int value = mid[c];
+      if (value > low && value < high) {
+        ++unsaturated_[gc];
+        response_[gc] += m[c];
+      }
+    }
+  }
+
+  ImageQuality q;
+  q.valid = true;
+  q.pixels = static_cast<std::uint32_t>((w - 2) * (h - 2));
+  const double edge = std::max(0.0, config_.edge_gradient);
+  for (std::size_t v = 0; v < all_.size(); ++v) {
+    if (static_cast<double>(v) >= edge) q.edge_pixels += all_[v];
+  }
+  q.edge_fraction = static_cast<double>(q.edge_pixels) / q.pixels;
+  const double lambda = std::max(1e-9, config_.gradient_rate);
+  q.gradient_metric = std::log1p(lambda * q.edge_fraction) / std::log1p(lambda);
+
+  // Threshold of h(): the smallest gradient bin t with at least homogeneous_fraction of the
+  // pixels at G < t.
+  const double want = std::clamp(config_.homogeneous_fraction, 0.0, 1.0) * q.pixels;
+  std::uint64_t cumulative = 0, noise_pixels = 0, response_sum = 0;
+  std::size_t threshold = 0;
+  while (threshold < all_.size() && static_cast<double>(cumulative) < want) {
+    cumulative += all_[threshold];
+    noise_pixels += unsaturated_[threshold];
+    response_sum += response_[threshold];
+    ++threshold;
+  }
+  q.homogeneous_gradient = static_cast<double>(threshold);
+  q.noise_pixels = static_cast<std::uint32_t>(noise_pixels);
+  q.noise_known = noise_pixels > 0 &&
+                  static_cast<double>(noise_pixels) >= config_.min_noise_fraction * q.pixels;
+  q.noise_sigma = q.noise_known
+                      ? std::sqrt(std::numbers::pi / 2.0) * static_cast<double>(response_sum) /
+                            (6.0 * static_cast<double>(noise_pixels))
+                      : config_.unknown_noise_sigma;
+  weigh(config_, q);
+  return q;
+}
+
+}  // namespace posed::vision
