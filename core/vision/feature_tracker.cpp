@@ -144,7 +144,9 @@ void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, Tra
     return tracks_[a].length > tracks_[b].length;
   });
   std::vector<std::uint8_t> keep(tracks_.size(), 0);
-  const int radius = static_cast<int>(std::lround(config_.min_distance_px));
+  // The disc covers pixels nearer than min_distance_px (cv::circle fills up to about r + 0.5),
+  // so corners goodFeaturesToTrack placed exactly min_distance_px apart do not evict each other.
+  const int radius = std::max(0, static_cast<int>(std::ceil(config_.min_distance_px)) - 1);
   for (const std::size_t i : order_) {
     const cv::Point p(static_cast<int>(std::lround(tracks_[i].pixel.x)),
                       static_cast<int>(std::lround(tracks_[i].pixel.y)));

@@ -16,7 +16,7 @@ void weigh(const QualityConfig& config, ImageQuality& quality) {
 
 QualityAssessor::QualityAssessor(const QualityConfig& config) : config_(config) {}
 
-ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
+ImageQuality QualityAssessor::assess(const cv::Mat& grey, double min_noise_sigma) {
   CV_Assert(grey.type() == CV_8UC1 && grey.rows >= 3 && grey.cols >= 3);
   all_.fill(0);
   unsaturated_.fill(0);
@@ -29,7 +29,7 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
     const std::uint8_t* up = grey.ptr<std::uint8_t>(r - 1);
     const std::uint8_t* mid = grey.ptr<std::uint8_t>(r);
     const std::uint8_t* down = grey.ptr<std::uint8_t>(r + 1);
-    std::uint8_t* g = gradient_row_.data();
+    std::uint16_t* g = gradient_row_.data();
     std::uint16_t* m = response_row_.data();
     // Sobel and Immerkaer's mask in 16-bit integers, branch-free (vectorised); the histograms in
     // the scalar loop below.
@@ -39,13 +39,13 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
       const int p = down[c - 1], q = down[c], s = down[c + 1];
       const int sx = (d + 2 * k + s) - (a + 2 * e + p);
       const int sy = (p + 2 * q + s) - (a + 2 * b + d);
-      const int magnitude = (std::abs(sx) + std::abs(sy)) >> 3;
-      g[c] = static_cast<std::uint8_t>(std::min(magnitude, 255));
+      // G in quarter grey/px: (|sx| + |sy|) / 8 * 4, at most 2040 / 2 = 1020 < kGradientBins.
+      g[c] = static_cast<std::uint16_t>((std::abs(sx) + std::abs(sy)) >> 1);
       const int laplace = (a + d + p + s) - 2 * (b + e + k + q) + 4 * f;
       m[c] = static_cast<std::uint16_t>(std::abs(laplace));
     }
     for (int c = 1; c < w - 1; ++c) {
-      const std::uint8_t gc = g[c];
+      const std::uint16_t gc = g[c];
       ++all_[gc];
       const int value = mid[c];
       if (value > low && value < high) {
@@ -58,16 +58,8 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
   ImageQuality q;
   q.valid = true;
   q.pixels = static_cast<std::uint32_t>((w - 2) * (h - 2));
-  const double edge = std::max(0.0, config_.edge_gradient);
-  for (std::size_t v = 0; v < all_.size(); ++v) {
-    if (static_cast<double>(v) >= edge) q.edge_pixels += all_[v];
-  }
-  q.edge_fraction = static_cast<double>(q.edge_pixels) / q.pixels;
-  const double lambda = std::max(1e-9, config_.gradient_rate);
-  q.gradient_metric = std::log1p(lambda * q.edge_fraction) / std::log1p(lambda);
-
-  // Threshold of h(): the smallest gradient bin t with at least homogeneous_fraction of the
-  // pixels at G < t.
+  // Noise first: the edge threshold depends on it. Threshold of h(): the smallest gradient bin
+  // t with at least homogeneous_fraction of the pixels at G < t.
   const double want = std::clamp(config_.homogeneous_fraction, 0.0, 1.0) * q.pixels;
   std::uint64_t cumulative = 0, noise_pixels = 0, response_sum = 0;
   std::size_t threshold = 0;
@@ -77,7 +69,7 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
     response_sum += response_[threshold];
     ++threshold;
   }
-  q.homogeneous_gradient = static_cast<double>(threshold);
+  q.homogeneous_gradient = static_cast<double>(threshold) / kBinsPerGrey;
   q.noise_pixels = static_cast<std::uint32_t>(noise_pixels);
   q.noise_known = noise_pixels > 0 &&
                   static_cast<double>(noise_pixels) >= config_.min_noise_fraction * q.pixels;
@@ -85,6 +77,19 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey) {
                       ? std::sqrt(std::numbers::pi / 2.0) * static_cast<double>(response_sum) /
                             (6.0 * static_cast<double>(noise_pixels))
                       : config_.unknown_noise_sigma;
+  q.noise_sigma = std::max(q.noise_sigma, min_noise_sigma);
+
+  // Edges: gradients above what the noise makes.
+  q.edge_threshold =
+      std::max(config_.edge_gradient,
+               config_.edge_noise_factor * (q.noise_known ? q.noise_sigma : min_noise_sigma));
+  const auto first_edge_bin = static_cast<std::size_t>(std::ceil(q.edge_threshold * kBinsPerGrey));
+  for (std::size_t v = std::min(first_edge_bin, all_.size()); v < all_.size(); ++v) {
+    q.edge_pixels += all_[v];
+  }
+  q.edge_fraction = static_cast<double>(q.edge_pixels) / q.pixels;
+  const double lambda = std::max(1e-9, config_.gradient_rate);
+  q.gradient_metric = std::log1p(lambda * q.edge_fraction) / std::log1p(lambda);
   weigh(config_, q);
   return q;
 }

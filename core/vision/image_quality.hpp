@@ -6,7 +6,10 @@
 // builds on, as follows (docs/frontend.md discusses each).
 //
 // Gradient G of a pixel: |Sobel_x| + |Sobel_y|, divided by 8 so that a ramp of slope s grey/px
-// along an axis has G = s [grey/px]. A pixel is an edge when G >= edge_gradient.
+// along an axis has G = s [grey/px] (a step of h grey gives G = h/2 beside it). A pixel is an
+// edge when G >= max(edge_gradient, edge_noise_factor sigma_n): a gradient the noise alone would
+// make is not an edge (on white noise G exceeds 2.5 sigma at ~0.001 % of the pixels), so noise
+// does not pass for texture.
 //   g = ln(1 + lambda n_e / n_t) / ln(1 + lambda)               (n_e edges of n_t pixels)
 // which is 0 without edges, 1 when every pixel is one, and rises faster for larger lambda (the
 // patent's "rate" parameter; the log saturation follows Shim et al. 2014's gradient metric).
@@ -20,6 +23,12 @@
 // clipping it. Too few qualifying pixels (a black or blown-out frame): sigma_n is unknown and
 // counts as `unknown_noise_sigma`.
 //
+// Immerkaer's estimator assumes white noise. Resampling correlates it and the estimate collapses
+// (white noise of 6 grey upsampled 1.42x, as the thermal image is: true 4.0, estimated 1.2), and
+// the noise then passes the edge threshold as texture. So images are assessed at their native
+// resolution (VisualFrontend assesses the thermal stream on its raw frame), and an image built
+// from resampled ones gets a lower bound (`min_noise_sigma`; for the fusion, the noisier source).
+//
 // Covariance weight and confidence:
 //   omega = clamp(lambda_n (sigma_n + lambda_g (1 - g)), omega_min, omega_max)
 //   confidence = omega_min / omega
@@ -28,6 +37,7 @@
 // clamp allows.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
 #include <vector>
@@ -35,7 +45,8 @@
 namespace posed::vision {
 
 struct QualityConfig {
-  double edge_gradient = 8.0;         ///< G at or above which a pixel is an edge [grey/px]
+  double edge_gradient = 4.0;         ///< least G at which a pixel is an edge [grey/px]
+  double edge_noise_factor = 2.5;     ///< edges also need G >= this x sigma_n [-]
   double gradient_rate = 30.0;        ///< lambda of the gradient metric [-]
   double homogeneous_fraction = 0.9;  ///< share of pixels, lowest G first, that h() keeps [0..1]
   int saturation_low = 8;             ///< eps_l: u() keeps I > this [grey]
@@ -55,6 +66,7 @@ struct ImageQuality {
   double noise_sigma = 0;           ///< sigma_n (or unknown_noise_sigma) [grey]
   bool noise_known = false;         ///< enough homogeneous unsaturated pixels
   double homogeneous_gradient = 0;  ///< the threshold sigma of h() chosen [grey/px]
+  double edge_threshold = 0;        ///< the edge threshold applied [grey/px]
   std::uint32_t pixels = 0;         ///< n_t, interior pixels assessed [1]
   std::uint32_t edge_pixels = 0;    ///< n_e [1]
   std::uint32_t noise_pixels = 0;   ///< N_s [1]
@@ -65,22 +77,28 @@ struct ImageQuality {
 /// omega and confidence from g and sigma_n (the last formulas above).
 void weigh(const QualityConfig& config, ImageQuality& quality);
 
+/// Gradient histogram resolution: G is binned in quarter grey/px up to 1020 / 4 = 255 grey/px.
+inline constexpr std::size_t kGradientBins = 1024;
+inline constexpr double kBinsPerGrey = 4.0;
+
 class QualityAssessor {
  public:
   explicit QualityAssessor(const QualityConfig& config);
 
-  /// Assesses a grey image (CV_8UC1, at least 3x3).
-  ImageQuality assess(const cv::Mat& grey);
+  /// Assesses a grey image (CV_8UC1, at least 3x3). `min_noise_sigma` [grey] bounds sigma_n
+  /// from below: for an image whose noise is known to be at least that (see below).
+  ImageQuality assess(const cv::Mat& grey, double min_noise_sigma = 0.0);
 
   const QualityConfig& config() const { return config_; }
 
  private:
   QualityConfig config_;
-  // Per gradient value G (0..255): all pixels, unsaturated pixels, and the sum of |I * M| over
-  // the unsaturated ones, so that the threshold of h() can be chosen after one pass.
-  std::array<std::uint32_t, 256> all_{}, unsaturated_{};
-  std::array<std::uint64_t, 256> response_{};
-  std::vector<std::uint8_t> gradient_row_;
+  // Per gradient bin (G in quarter grey/px, 0..1020): all pixels, unsaturated pixels, and the sum
+  // of |I * M| over the unsaturated ones, so that the threshold of h() can be chosen after one
+  // pass.
+  std::array<std::uint32_t, kGradientBins> all_{}, unsaturated_{};
+  std::array<std::uint64_t, kGradientBins> response_{};
+  std::vector<std::uint16_t> gradient_row_;
   std::vector<std::uint16_t> response_row_;
 };
 

@@ -1,5 +1,6 @@
 #include "core/vision/thermal_aligner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
@@ -34,10 +35,10 @@ ThermalAligner::ThermalAligner(const PinholeCamera& visible, const PinholeCamera
     for (int c = 0; c < visible.width; ++c) {
       Eigen::Vector2d xy;
       if (config_.mode == AlignMode::kFovCrop) {
-        // Eq. (6) crop resampled to the visible size (pixel centres map to pixel centres), in
-        // undistorted thermal pixels, then normalised by the thermal intrinsics.
-        const double u = crop_.left_px + (c + 0.5) * crop_.width_px / visible.width - 0.5;
-        const double v = crop_.top_px + (r + 0.5) * crop_.height_px / visible.height - 0.5;
+        // Eq. (6) crop resampled to the visible size: the visible image's extent [-0.5, W - 0.5]
+        // onto the crop's [left, left + X'] in undistorted thermal pixels, then normalised.
+        const double u = crop_.left_px + (c + 0.5) * crop_.width_px / visible.width;
+        const double v = crop_.top_px + (r + 0.5) * crop_.height_px / visible.height;
         xy = {(u - thermal.cx) / thermal.fx, (v - thermal.cy) / thermal.fy};
       } else if (!visible.normalised_from_pixel(Eigen::Vector2d(c, r), xy)) {
         xy = {1e6, 1e6};  // beyond any lens's model: the map marks it invalid
@@ -57,6 +58,33 @@ ThermalAligner::ThermalAligner(const PinholeCamera& visible, const PinholeCamera
   cv::convertMaps(map_x_, map_y_, static_map_xy_, static_map_frac_, CV_16SC2);
   static_valid_ = valid_.clone();
   static_invalid_ = invalid_;
+  double x_lo = thermal.width, x_hi = -1, y_lo = thermal.height, y_hi = -1;
+  for (int r = 0; r < map_x_.rows; ++r) {
+    for (int c = 0; c < map_x_.cols; ++c) {
+      if (valid_.at<std::uint8_t>(r, c) == 0) continue;
+      x_lo = std::min(x_lo, static_cast<double>(map_x_.at<float>(r, c)));
+      x_hi = std::max(x_hi, static_cast<double>(map_x_.at<float>(r, c)));
+      y_lo = std::min(y_lo, static_cast<double>(map_y_.at<float>(r, c)));
+      y_hi = std::max(y_hi, static_cast<double>(map_y_.at<float>(r, c)));
+    }
+  }
+  if (x_hi >= x_lo && y_hi >= y_lo) {
+    const int x0 = static_cast<int>(std::floor(x_lo)), y0 = static_cast<int>(std::floor(y_lo));
+    const int x1 = std::min(thermal.width, static_cast<int>(std::ceil(x_hi)) + 1);
+    const int y1 = std::min(thermal.height, static_cast<int>(std::ceil(y_hi)) + 1);
+    source_roi_ = cv::Rect(x0, y0, x1 - x0, y1 - y0);
+  }
+}
+
+void ThermalAligner::native_grey(const cv::Mat& thermal, const AlignStats& stats,
+                                 cv::Mat& grey) const {
+  const cv::Mat roi = thermal(source_roi_);
+  if (thermal.type() == CV_8UC1) {
+    grey = roi;
+    return;
+  }
+  const double span = std::max(1, stats.normalize.high_counts - stats.normalize.low_counts);
+  roi.convertTo(grey, CV_8U, 255.0 / span, -255.0 * stats.normalize.low_counts / span);
 }
 
 void ThermalAligner::total_transform(const Eigen::Matrix3d& R_camtv_camtt, Eigen::Matrix3d& R,
@@ -125,9 +153,8 @@ bool ThermalAligner::thermal_pixel(const Eigen::Vector2d& visible_px,
                                    Eigen::Vector2d& thermal_px) const {
   Eigen::Vector2d xy;
   if (config_.mode == AlignMode::kFovCrop) {
-    const double u = crop_.left_px + (visible_px.x() + 0.5) * crop_.width_px / visible_.width - 0.5;
-    const double v =
-        crop_.top_px + (visible_px.y() + 0.5) * crop_.height_px / visible_.height - 0.5;
+    const double u = crop_.left_px + (visible_px.x() + 0.5) * crop_.width_px / visible_.width;
+    const double v = crop_.top_px + (visible_px.y() + 0.5) * crop_.height_px / visible_.height;
     xy = {(u - thermal_.cx) / thermal_.fx, (v - thermal_.cy) / thermal_.fy};
   } else if (!visible_.normalised_from_pixel(visible_px, xy)) {
     return false;

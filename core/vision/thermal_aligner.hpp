@@ -79,6 +79,15 @@ class ThermalAligner {
   bool thermal_pixel(const Eigen::Vector2d& visible_px, const Eigen::Matrix3d& R_camtv_camtt,
                      Eigen::Vector2d& thermal_px) const;
 
+  /// The raw thermal pixels the visible image samples (bounding box of the static map), in the
+  /// thermal frame.
+  const cv::Rect& source_roi() const { return source_roi_; }
+
+  /// That region of `thermal` at its native resolution as 8-bit grey, for measurements that
+  /// resampling would bias (image noise, see image_quality.hpp): a view for 8-bit frames, or
+  /// the 16-bit counts through the stretch `stats` reports for the last align().
+  void native_grey(const cv::Mat& thermal, const AlignStats& stats, cv::Mat& grey) const;
+
   /// The eq. (6) crop (kFovCrop's region, reported for every mode).
   const FovCrop& fov_crop() const { return crop_; }
   const ThermalAlignConfig& config() const { return config_; }
@@ -102,6 +111,7 @@ class ThermalAligner {
   cv::Mat map_x_, map_y_, valid_;
   cv::Mat static_map_xy_, static_map_frac_, static_valid_;
   int static_invalid_ = 0;
+  cv::Rect source_roi_;
   int invalid_ = 0;
   cv::Mat remapped_counts_;
   ThermalNormalizer normalizer_;

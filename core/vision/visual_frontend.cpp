@@ -143,9 +143,25 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
 
   if (config_.assess_quality) {
     begin(FrontendStep::kQuality);
+    // Each stream at its native resolution: the thermal on its raw pixels (resampling would hide
+    // its noise from the estimator, see image_quality.hpp).
     if (use_visible) out.quality.visible = quality_.assess(visible_grey_);
-    if (use_thermal) out.quality.thermal = quality_.assess(thermal_grey_);
-    if (mode == FrontendMode::kFused) out.quality.fused = quality_.assess(fused_grey_);
+    if (use_thermal) {
+      aligner_->native_grey(input.thermal, out.thermal_alignment, thermal_native_);
+      if (config_.thermal_enhance.enabled) {
+        thermal_enhancer_.enhance_to_grey(thermal_native_, false, thermal_native_);
+      }
+      out.quality.thermal = quality_.assess(thermal_native_);
+    }
+    if (mode == FrontendMode::kFused) {
+      // The fusion keeps each detail coefficient of the noisier-looking source where it is larger,
+      // so its noise is at least the noisier source's, the thermal one scaled by the upsampling.
+      const double thermal_scale =
+          aligner_->source_roi().width / static_cast<double>(config_.visible_camera.width);
+      const double floor = std::max(out.quality.visible.noise_sigma,
+                                    out.quality.thermal.noise_sigma * thermal_scale);
+      out.quality.fused = quality_.assess(fused_grey_, floor);
+    }
     end(FrontendStep::kQuality);
   }
 

@@ -115,7 +115,7 @@ class VisualFrontend {
   DepthAssociator depth_;
   FrontendStepProbe* probe_ = nullptr;
 
-  cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, fused_grey_;
+  cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, thermal_native_, fused_grey_;
   // previous frame's features (id order) for the velocities
   std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> previous_;
   HostTime previous_stamp_;
