@@ -140,34 +140,72 @@ DepthResult DepthAssociator::depth(const Eigen::Vector2d& normalised) const {
   if (points_.size() < 3) return result;
   const Eigen::Vector3d ray = Eigen::Vector3d(normalised.x(), normalised.y(), 1.0).normalized();
   const Eigen::Vector2f key = polar_of(ray.x(), ray.y(), ray.z());
-  std::array<std::uint32_t, 3> index{};
-  std::array<float, 3> distance_sq{};
-  if (tree_->index.knnSearch(key.data(), 3, index.data(), distance_sq.data()) < 3) return result;
+  constexpr std::size_t kMaxCandidates = 32;
+  const std::size_t wanted = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::max(config_.candidates, 3)), 3, kMaxCandidates);
+  std::array<std::uint32_t, kMaxCandidates> index{};
+  std::array<float, kMaxCandidates> distance_sq{};
+  const std::size_t found =
+      tree_->index.knnSearch(key.data(), wanted, index.data(), distance_sq.data());
+  if (found < 3) return result;
 
-  std::array<Eigen::Vector3d, 3> P;
-  std::array<double, 3> range{};
+  // Candidates nearest first; each must lie within the search radius (true angle, not the
+  // polar-key distance). The first two are the paper's nearest two.
   const double cos_max = std::cos(config_.max_neighbour_angle_rad);
+  const auto within = [&](std::size_t k) {
+    const Eigen::Vector3d p = points_[index[k]].cast<double>();
+    return p.dot(ray) >= cos_max * p.norm();
+  };
   for (std::size_t k = 0; k < 3; ++k) {
-    P[k] = points_[index[k]].cast<double>();
-    range[k] = P[k].norm();
-    if (P[k].dot(ray) < cos_max * range[k]) {  // true angle, not the polar-key distance
+    if (!within(k)) {
       result.status = DepthStatus::kTooFar;
       return result;
     }
   }
-  const double r_min = *std::min_element(range.begin(), range.end());
-  const double r_max = *std::max_element(range.begin(), range.end());
-  const double d01 = (P[0] - P[1]).norm(), d02 = (P[0] - P[2]).norm(), d12 = (P[1] - P[2]).norm();
-  result.span_m =
-      config_.span == SpanMeasure::kMaxPairwiseDistance ? std::max({d01, d02, d12}) : r_max - r_min;
+  const Eigen::Vector3d P0 = points_[index[0]].cast<double>();
+  const Eigen::Vector3d P1 = points_[index[1]].cast<double>();
+  // 2 area / longest side^2 of a triangle: 0 collinear, sqrt(3)/2 equilateral.
+  const auto shape = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                        const Eigen::Vector3d& c) {
+    const double longest =
+        std::max({(a - b).squaredNorm(), (a - c).squaredNorm(), (b - c).squaredNorm()});
+    return longest > 0 ? (b - a).cross(c - a).norm() / longest : 0.0;
+  };
+  const auto span_of = [&](const std::array<Eigen::Vector3d, 3>& T) {
+    if (config_.span == SpanMeasure::kRangeSpread) {
+      const double a = T[0].norm(), b = T[1].norm(), c = T[2].norm();
+      return std::max({a, b, c}) - std::min({a, b, c});
+    }
+    return std::max({(T[0] - T[1]).norm(), (T[0] - T[2]).norm(), (T[1] - T[2]).norm()});
+  };
+  // The paper's test on the 3 nearest first: a depth edge among them rejects the feature, even
+  // if a replacement third point would hide it.
+  std::array<Eigen::Vector3d, 3> P = {P0, P1, points_[index[2]].cast<double>()};
+  result.span_m = span_of(P);
   if (result.span_m > config_.max_span_m) {
     result.status = DepthStatus::kSpan;
     return result;
   }
+  if (shape(P[0], P[1], P[2]) < config_.min_triangle_shape) {
+    for (std::size_t k = 3; k < found && within(k); ++k) {
+      const Eigen::Vector3d candidate = points_[index[k]].cast<double>();
+      if (shape(P0, P1, candidate) < config_.min_triangle_shape) continue;
+      P[2] = candidate;
+      result.span_m = span_of(P);
+      if (result.span_m > config_.max_span_m) {
+        result.status = DepthStatus::kSpan;
+        return result;
+      }
+      break;
+    }
+  }
+  std::array<double, 3> range{};
+  for (std::size_t k = 0; k < 3; ++k) range[k] = P[k].norm();
+  const double r_min = *std::min_element(range.begin(), range.end());
+  const double r_max = *std::max_element(range.begin(), range.end());
   const Eigen::Vector3d n = (P[1] - P[0]).cross(P[2] - P[0]);
-  const double longest = std::max({d01, d02, d12});
   const double n_norm = n.norm();
-  if (!(longest > 0) || n_norm < config_.min_triangle_shape * longest * longest ||
+  if (shape(P[0], P[1], P[2]) < config_.min_triangle_shape ||
       std::abs(n.dot(ray)) < std::sin(config_.min_incidence_rad) * n_norm) {
     result.status = DepthStatus::kDegenerate;
     return result;

@@ -14,12 +14,16 @@
 //    any triangle on a surface facing the camera however wide, so it is weaker at depth edges.
 //  - depth: z of the intersection s b of the unit ray b with the plane, s = (n . P_1) / (n . b),
 //    n = (P_2 - P_1) x (P_3 - P_1) [m]: the same depth the normalised coordinates (x/z, y/z) use.
-// Beyond seed 000 a feature also gets no depth when its 3 points are further than
-// `max_neighbour_angle_rad` from its bearing, nearly collinear, seen edge-on, or when the
-// intersection lies outside their range interval by more than `max_extrapolation_m` (LVI-SAM
-// clamps it there instead, inventing a depth). Before the tree is built the points are culled to
-// the camera's field of view and thinned to the nearest point per `cell_rad` cell of the polar
-// grid (LVI-SAM does the same), so nearer surfaces hide the ones behind them.
+// A spinning lidar samples 0.2 deg along a ring but 0.33-1.3 deg between rings, so the 3 nearest
+// points often lie on one ring: collinear, no plane. Then the third point is the nearest of the
+// next `candidates` that makes a proper triangle with the first two (LVI-SAM keeps the degenerate
+// plane and clamps the intersection into the points' range interval, which invents a depth).
+// Beyond seed 000 a feature also gets no depth when its points are further than
+// `max_neighbour_angle_rad` from its bearing, collinear after all, seen edge-on, or when the
+// intersection lies outside their range interval by more than `max_extrapolation_m`. Before the
+// tree is built the points are culled to the camera's field of view and thinned to the nearest
+// point per `cell_rad` cell of the polar grid (LVI-SAM does the same), so nearer surfaces hide the
+// ones behind them.
 
 #include <Eigen/Core>
 #include <cmath>
@@ -45,7 +49,8 @@ struct DepthConfig {
   double max_range_m = 120.0;               ///< further points are ignored [m]
   double max_extrapolation_m = 0.5;         ///< intersection beyond the 3 ranges [m]
   double min_triangle_shape = 0.05;         ///< 2 area / longest side^2; below: collinear [-]
-  double min_incidence_rad = 0.0873;        ///< 5 deg; ray closer to the plane: edge-on [rad]
+  int candidates = 16;                ///< neighbours searched for a non-collinear third point [1]
+  double min_incidence_rad = 0.0873;  ///< 5 deg; ray closer to the plane: edge-on [rad]
 };
 
 enum class DepthStatus : std::uint8_t {

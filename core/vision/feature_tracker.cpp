@@ -48,7 +48,10 @@ TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask
   CV_Assert(grey.type() == CV_8UC1);
   TrackStats stats;
   const cv::Size window(config_.klt_window_px, config_.klt_window_px);
-  cv::buildOpticalFlowPyramid(grey, pyramid_, window, config_.klt_pyramid_levels, true);
+  // A copy, not a view of `grey` (tryReuseInputImage = false): the caller may overwrite its
+  // image before the next frame, which tracks from this pyramid.
+  cv::buildOpticalFlowPyramid(grey, pyramid_, window, config_.klt_pyramid_levels, true,
+                              cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, false);
   stats.previous = static_cast<int>(tracks_.size());
 
   if (!tracks_.empty() && !previous_pyramid_.empty()) {

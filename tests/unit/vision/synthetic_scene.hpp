@@ -4,6 +4,7 @@
 // fusion, tracking and depth can be checked against geometry known exactly.
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <opencv2/core.hpp>
@@ -137,16 +138,25 @@ inline cv::Mat add_noise(const cv::Mat& image, double sigma, std::uint64_t seed)
 }
 
 /// A textured grey image without any camera model: `wall_texture` sampled on a pixel grid of
-/// `metres_per_px`, brightness gain * texture + offset.
+/// `metres_per_px`, brightness gain * texture + offset, shifted by (shift_x_px, shift_y_px).
+/// Each pixel averages `supersample`^2 samples over its area, so that sub-pixel shifts of the
+/// tiles' hard edges move the image as a camera would see them (no aliasing).
 inline cv::Mat texture_image(int width, int height, double metres_per_px, double gain,
                              double offset, std::uint32_t seed, double shift_x_px = 0,
-                             double shift_y_px = 0) {
+                             double shift_y_px = 0, int supersample = 1) {
+  const int n = std::max(1, supersample);
   cv::Mat image(height, width, CV_8UC1);
   for (int r = 0; r < height; ++r) {
     for (int c = 0; c < width; ++c) {
-      const double X = (c - shift_x_px) * metres_per_px, Y = (r - shift_y_px) * metres_per_px;
-      image.at<std::uint8_t>(r, c) =
-          cv::saturate_cast<std::uint8_t>(offset + gain * wall_texture(X, Y, seed));
+      double sum = 0;
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          const double x = c - 0.5 + (j + 0.5) / n - shift_x_px;
+          const double y = r - 0.5 + (i + 0.5) / n - shift_y_px;
+          sum += wall_texture(x * metres_per_px, y * metres_per_px, seed);
+        }
+      }
+      image.at<std::uint8_t>(r, c) = cv::saturate_cast<std::uint8_t>(offset + gain * sum / (n * n));
     }
   }
   return image;
