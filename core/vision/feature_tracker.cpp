@@ -161,6 +161,7 @@ void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, Tra
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     if (keep[i] != 0) tracks_[kept++] = tracks_[i];
   }
+  stats.crowded = static_cast<int>(tracks_.size() - kept);
   tracks_.resize(kept);
 
   const int wanted = config_.max_features - static_cast<int>(tracks_.size());

@@ -50,8 +50,9 @@ struct TrackStats {
   int previous = 0;        ///< tracks carried in from the last frame [1]
   int klt_tracked = 0;     ///< of those, found by KLT (and the round trip), inside the image [1]
   int ransac_inliers = 0;  ///< of those, consistent with the fundamental matrix [1]
-  int extracted = 0;       ///< new corners added [1]
-  int total = 0;           ///< tracks now [1]
+  int crowded = 0;    ///< of those, dropped for lying within min_distance of a longer track [1]
+  int extracted = 0;  ///< new corners added [1]
+  int total = 0;      ///< tracks now [1]
 };
 
 /// RANSAC fundamental-matrix rejection on matched undistorted pixel coordinates: clears

@@ -58,6 +58,7 @@ struct FrontendCounts {
   int previous = 0;          ///< features carried in from the previous frame [1]
   int tracked = 0;           ///< of those, tracked by KLT (and the round trip) [1]
   int ransac_inliers = 0;    ///< of those, kept by the fundamental-matrix RANSAC [1]
+  int crowded = 0;           ///< of those, dropped within min_distance of a longer track [1]
   int extracted = 0;         ///< new features detected this frame [1]
   int features = 0;          ///< features output [1]
   int depth_associated = 0;  ///< of those, with a lidar depth [1]

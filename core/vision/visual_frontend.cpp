@@ -211,6 +211,7 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
   out.counts.previous = stats.previous;
   out.counts.tracked = stats.klt_tracked;
   out.counts.ransac_inliers = stats.ransac_inliers;
+  out.counts.crowded = stats.crowded;
   out.counts.extracted = stats.extracted;
   out.counts.features = static_cast<int>(out.features.size());
   out.counts.lines = static_cast<int>(out.lines.size());
