@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <nanoflann.hpp>
+#include <numbers>
 
 namespace posed::vision {
 namespace {
@@ -21,9 +22,28 @@ struct PolarCloud {
   }
 };
 
+/// atan(t) to 2e-8 rad: Abramowitz & Stegun 4.4.49 on [-1, 1], atan(t) = pi/2 - atan(1/t)
+/// beyond. Twice for each of ~10k points per frame, where std::atan2 cost a third of the step.
+double fast_atan(double t) {
+  const bool outside = std::abs(t) > 1.0;
+  const double u = outside ? 1.0 / t : t, u2 = u * u;
+  const double p =
+      u * (1.0 + u2 * (-0.3333314528 +
+                       u2 * (0.1999355085 +
+                             u2 * (-0.1420889944 +
+                                   u2 * (0.1065626393 +
+                                         u2 * (-0.0752896400 +
+                                               u2 * (0.0429096138 + u2 * (-0.0161657367 +
+                                                                          u2 * 0.0028662257))))))));
+  if (!outside) return p;
+  return (t > 0 ? std::numbers::pi / 2 : -std::numbers::pi / 2) - p;
+}
+
+/// Polar coordinates of a direction in front of the camera (z > 0): azimuth atan2(x, z),
+/// elevation atan2(y, hypot(x, z)) [rad].
 Eigen::Vector2f polar_of(double x, double y, double z) {
-  return {static_cast<float>(std::atan2(x, z)),
-          static_cast<float>(std::atan2(y, std::hypot(x, z)))};
+  const double horizontal = std::sqrt(x * x + z * z);
+  return {static_cast<float>(fast_atan(x / z)), static_cast<float>(fast_atan(y / horizontal))};
 }
 
 }  // namespace

@@ -29,7 +29,7 @@ int reject_with_fundamental(const std::vector<cv::Point2f>& previous,
 }
 
 FeatureTracker::FeatureTracker(const TrackerConfig& config, const PinholeCamera& camera)
-    : config_(config), camera_(camera) {}
+    : config_(config), camera_(camera), undistorter_(camera) {}
 
 void FeatureTracker::reset() {
   tracks_.clear();
@@ -37,11 +37,7 @@ void FeatureTracker::reset() {
 }
 
 Eigen::Vector2d FeatureTracker::normalise(const cv::Point2f& pixel) const {
-  Eigen::Vector2d xy;
-  if (!camera_.normalised_from_pixel(Eigen::Vector2d(pixel.x, pixel.y), xy)) {
-    xy.setConstant(std::numeric_limits<double>::quiet_NaN());
-  }
-  return xy;
+  return undistorter_.normalised(Eigen::Vector2d(pixel.x, pixel.y));
 }
 
 TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask) {
@@ -65,9 +61,11 @@ TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask
                              config_.klt_pyramid_levels, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
     if (config_.forward_backward_check) {
       back_ = from_;
+      // Back from where the forward pass ended, starting at the point it came from: a correct
+      // track is already within a pixel or two, so the finest level alone suffices (a quarter of
+      // the forward pass's cost).
       cv::calcOpticalFlowPyrLK(pyramid_, previous_pyramid_, to_, back_, back_status_, error_,
-                               window, config_.klt_pyramid_levels, criteria,
-                               cv::OPTFLOW_USE_INITIAL_FLOW);
+                               window, 0, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
       const double max_sq = config_.max_forward_backward_px * config_.max_forward_backward_px;
       for (std::size_t i = 0; i < n; ++i) {
         const cv::Point2f d = back_[i] - from_[i];
@@ -132,13 +130,26 @@ TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask
 }
 
 void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, TrackStats& stats) {
+  // Corners are looked for on pyramid level `detect_level`; the mask lives at that resolution
+  // too (its discs then cost a quarter per level). pyramid_ holds image and derivatives per
+  // level: level l's image is element 2 l (fewer levels exist for tiny images).
+  int level = std::clamp(config_.detect_level, 0, config_.klt_pyramid_levels);
+  while (level > 0 && pyramid_.size() <= static_cast<std::size_t>(2 * level)) --level;
+  const cv::Mat& image = level == 0 ? grey : pyramid_[static_cast<std::size_t>(2 * level)];
+  const double scale = static_cast<double>(1 << level);
   if (detect_mask.empty()) {
-    mask_.create(grey.size(), CV_8UC1);
+    mask_.create(image.size(), CV_8UC1);
     mask_.setTo(255);
   } else {
     CV_Assert(detect_mask.type() == CV_8UC1 && detect_mask.size() == grey.size());
-    detect_mask.copyTo(mask_);
+    cv::resize(detect_mask, mask_, image.size(), 0, 0, cv::INTER_NEAREST);
   }
+  // Full-resolution pixel p lies in level pixel (p + 0.5) / s - 0.5.
+  const auto to_level = [scale](const cv::Point2f& p) {
+    return cv::Point(static_cast<int>(std::lround((p.x + 0.5) / scale - 0.5)),
+                     static_cast<int>(std::lround((p.y + 0.5) / scale - 0.5)));
+  };
+
   // Longest tracks claim their disc first; a track inside an older one's disc is dropped, so the
   // set stays spread out (VINS-Mono's setMask).
   order_.resize(tracks_.size());
@@ -147,13 +158,14 @@ void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, Tra
     return tracks_[a].length > tracks_[b].length;
   });
   std::vector<std::uint8_t> keep(tracks_.size(), 0);
-  // The disc covers pixels nearer than min_distance_px (cv::circle fills up to about r + 0.5),
-  // so corners goodFeaturesToTrack placed exactly min_distance_px apart do not evict each other.
-  const int radius = std::max(0, static_cast<int>(std::ceil(config_.min_distance_px)) - 1);
+  // The disc covers pixels nearer than min_distance (cv::circle fills up to about r + 0.5), so
+  // corners goodFeaturesToTrack placed exactly min_distance apart do not evict each other.
+  const double min_distance = config_.min_distance_px / scale;
+  const int radius = std::max(0, static_cast<int>(std::ceil(min_distance)) - 1);
+  const cv::Rect inside(0, 0, mask_.cols, mask_.rows);
   for (const std::size_t i : order_) {
-    const cv::Point p(static_cast<int>(std::lround(tracks_[i].pixel.x)),
-                      static_cast<int>(std::lround(tracks_[i].pixel.y)));
-    if (mask_.at<std::uint8_t>(p) == 0) continue;
+    const cv::Point p = to_level(tracks_[i].pixel);
+    if (!inside.contains(p) || mask_.at<std::uint8_t>(p) == 0) continue;
     keep[i] = 1;
     cv::circle(mask_, p, radius, cv::Scalar(0), cv::FILLED);
   }
@@ -166,10 +178,13 @@ void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, Tra
 
   const int wanted = config_.max_features - static_cast<int>(tracks_.size());
   if (wanted <= 0) return;
-  cv::goodFeaturesToTrack(grey, corners_, wanted, config_.corner_quality, config_.min_distance_px,
-                          mask_, config_.corner_block_size);
+  cv::goodFeaturesToTrack(image, corners_, wanted, config_.corner_quality, min_distance, mask_,
+                          config_.corner_block_size);
   const float border = static_cast<float>(config_.border_px);
-  for (const cv::Point2f& c : corners_) {
+  for (cv::Point2f c : corners_) {
+    // Level pixel x covers full-resolution pixels [x s, x s + s - 1]: centre (x + 0.5) s - 0.5.
+    c.x = static_cast<float>((c.x + 0.5) * scale - 0.5);
+    c.y = static_cast<float>((c.y + 0.5) * scale - 0.5);
     if (c.x < border || c.y < border || c.x > static_cast<float>(grey.cols - 1) - border ||
         c.y > static_cast<float>(grey.rows - 1) - border) {
       continue;

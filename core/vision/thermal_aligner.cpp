@@ -118,6 +118,7 @@ void ThermalAligner::compute_map(const Eigen::Matrix3f& R, const Eigen::Vector3f
   const float max_u = static_cast<float>(thermal_.width - 1);
   const float max_v = static_cast<float>(thermal_.height - 1);
   int invalid = 0;
+  const int cols = ray_x_.cols;  // a local: the loops' trip count must not depend on stores
   for (int r = 0; r < ray_x_.rows; ++r) {
     const float* rx = ray_x_.ptr<float>(r);
     const float* ry = ray_y_.ptr<float>(r);
@@ -126,7 +127,7 @@ void ThermalAligner::compute_map(const Eigen::Matrix3f& R, const Eigen::Vector3f
     std::uint8_t* ok = valid_.ptr<std::uint8_t>(r);
     // Branch-free so that the compiler vectorises it: (x, y, 1) rotated (+ t), projected,
     // distorted (radial-tangential), scaled; misses are selected out at the end.
-    for (int c = 0; c < ray_x_.cols; ++c) {
+    for (int c = 0; c < cols; ++c) {
       const float X = r00 * rx[c] + r01 * ry[c] + r02;
       const float Y = r10 * rx[c] + r11 * ry[c] + r12;
       const float Z = r20 * rx[c] + r21 * ry[c] + r22;
@@ -138,12 +139,15 @@ void ThermalAligner::compute_map(const Eigen::Matrix3f& R, const Eigen::Vector3f
       const float xd = x * radial + 2.f * p1 * x * y + p2 * (r2 + 2.f * x * x);
       const float yd = y * radial + p1 * (r2 + 2.f * y * y) + 2.f * p2 * x * y;
       const float u = fx * xd + cx, v = fy * yd + cy;
-      const bool inside = in_front && u >= 0.f && u <= max_u && v >= 0.f && v <= max_v;
+      // & rather than &&: no short-circuit branches in the loop body.
+      const bool inside = in_front & (u >= 0.f) & (u <= max_u) & (v >= 0.f) & (v <= max_v);
       mx[c] = inside ? u : kOutside;
       my[c] = inside ? v : kOutside;
-      ok[c] = inside ? 255 : 0;
     }
-    for (int c = 0; c < ray_x_.cols; ++c) invalid += ok[c] == 0 ? 1 : 0;
+    for (int c = 0; c < cols; ++c) {
+      ok[c] = mx[c] >= 0.f ? 255 : 0;
+      invalid += mx[c] >= 0.f ? 0 : 1;
+    }
   }
   invalid_ = invalid;
 }
@@ -183,6 +187,8 @@ bool ThermalAligner::align(const cv::Mat& thermal, const Eigen::Matrix3d& R_camt
     Eigen::Vector3d t;
     total_transform(R_camtv_camtt, R, t);
     compute_map(R.cast<float>(), t.cast<float>());
+    // Fixed point for cv::remap: it would convert float maps block by block anyway, slower.
+    cv::convertMaps(map_x_, map_y_, map_xy_, map_frac_, CV_16SC2);
     valid = &valid_;
     stats.invalid_pixels = invalid_;
   } else {
@@ -193,7 +199,7 @@ bool ThermalAligner::align(const cv::Mat& thermal, const Eigen::Matrix3d& R_camt
 
   const auto remap = [&](const cv::Mat& src, cv::Mat& dst) {
     if (compensate) {
-      cv::remap(src, dst, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+      cv::remap(src, dst, map_xy_, map_frac_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
     } else {
       cv::remap(src, dst, static_map_xy_, static_map_frac_, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
                 cv::Scalar(0));

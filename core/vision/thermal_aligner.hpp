@@ -108,7 +108,7 @@ class ThermalAligner {
   // thermal coordinates of the crop.
   cv::Mat ray_x_, ray_y_;  // CV_32FC1
   // The current map (float), its fixed-point form for the static case, and validity.
-  cv::Mat map_x_, map_y_, valid_;
+  cv::Mat map_x_, map_y_, map_xy_, map_frac_, valid_;
   cv::Mat static_map_xy_, static_map_frac_, static_valid_;
   int static_invalid_ = 0;
   cv::Rect source_roi_;

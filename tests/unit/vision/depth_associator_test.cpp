@@ -79,8 +79,12 @@ TEST(DepthAssociator, RejectsNeighboursStraddlingADepthEdge) {
         const bool near_wall = std::abs(r.depth_m - 5.0) < 1e-3;
         const bool far_wall = std::abs(r.depth_m - 12.0) < 1e-3;
         EXPECT_TRUE(near_wall || far_wall) << x << "," << y << ": " << r.depth_m;
-        if (x < 0.05 - 0.01) EXPECT_TRUE(near_wall) << x << "," << y;
-        if (x > 0.05 + 0.01) EXPECT_TRUE(far_wall) << x << "," << y;
+        if (x < 0.05 - 0.01) {
+          EXPECT_TRUE(near_wall) << x << "," << y;
+        }
+        if (x > 0.05 + 0.01) {
+          EXPECT_TRUE(far_wall) << x << "," << y;
+        }
       }
       if (std::abs(x - 0.05) < 0.004) {  // within ~0.25 deg of the edge
         ++edge_probes;
@@ -135,7 +139,9 @@ TEST(DepthAssociator, NearerSurfaceHidesTheOneBehind) {
   depth.set_points(stacked);
   for (double x = -0.3; x <= 0.3; x += 0.1) {
     const DepthResult r = depth.depth({x, 0.013});
-    if (r.status == DepthStatus::kOk) EXPECT_NEAR(r.depth_m, 4.0, 1e-3);
+    if (r.status == DepthStatus::kOk) {
+      EXPECT_NEAR(r.depth_m, 4.0, 1e-3);
+    }
   }
 }
 

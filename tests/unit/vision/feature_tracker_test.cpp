@@ -59,7 +59,9 @@ TEST(FeatureTracker, FollowsAKnownShiftWithStableIds) {
       EXPECT_EQ(t.length, static_cast<std::uint32_t>(frame - born[t.id] + 1));
       ++continuing;
     }
-    if (frame > 0) EXPECT_GT(continuing, 240) << frame;
+    if (frame > 0) {
+      EXPECT_GT(continuing, 240) << frame;
+    }
   }
   ASSERT_FALSE(errors.empty());
   std::sort(errors.begin(), errors.end());
@@ -76,10 +78,14 @@ TEST(FeatureTracker, IdsAreNeverReused) {
     // A different texture each frame: most tracks are lost and replaced by new ones.
     const TrackStats stats =
         tracker.track(scene::texture_image(320, 240, 0.01, 200, 25, 40 + frame), {});
-    if (frame > 0) EXPECT_GT(stats.extracted, 20);
+    if (frame > 0) {
+      EXPECT_GT(stats.extracted, 20);
+    }
     std::vector<std::uint64_t> ids;
     for (const Track& t : tracker.tracks()) {
-      if (frame > 0 && t.length == 1) EXPECT_GT(t.id, highest);  // new: a fresh id
+      if (frame > 0 && t.length == 1) {
+        EXPECT_GT(t.id, highest);  // new: a fresh id
+      }
       ids.push_back(t.id);
     }
     std::sort(ids.begin(), ids.end());

@@ -41,14 +41,15 @@ TEST(LineTracker, TracksSegmentsWithStableIds) {
   std::map<std::uint64_t, int> born;
   int continued = 0;
   for (int frame = 0; frame < 4; ++frame) {
-    const LineStats stats = tracker.track(rectangles(step.x * frame, step.y * frame));
+    const float f = static_cast<float>(frame);
+    const LineStats stats = tracker.track(rectangles(step.x * f, step.y * f));
     EXPECT_LE(stats.total, 50);
     if (frame == 0) {
       EXPECT_GE(stats.detected, 12);  // 3 rectangles x 4 sides
     } else {
       EXPECT_GE(stats.tracked, 12) << frame;
     }
-    const Eigen::Vector2f shift(step.x * frame, step.y * frame);
+    const Eigen::Vector2f shift(step.x * f, step.y * f);
     for (const LineFeature& l : tracker.lines()) {
       if (born.emplace(l.id, frame).second) {
         first[l.id] = {l.start_px - shift, l.end_px - shift};

@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <opencv2/core.hpp>
+
+#include "core/vision/undistorter.hpp"
 #include "tests/unit/vision/synthetic_scene.hpp"
 
 namespace posed::vision {
@@ -61,6 +65,24 @@ TEST(PinholeCamera, FieldOfViewOfTheM2dgrCameras) {
   EXPECT_NEAR(scene::m2dgr_visible().vertical_fov_rad() * kDeg, 42.545, 0.001);
   EXPECT_NEAR(scene::m2dgr_thermal().horizontal_fov_rad() * kDeg, 72.574, 0.001);
   EXPECT_NEAR(scene::m2dgr_thermal().vertical_fov_rad() * kDeg, 60.850, 0.001);
+}
+
+TEST(Undistorter, TableAndOneStepMatchTheIterativeInverse) {
+  for (const PinholeCamera& camera : {scene::m2dgr_visible(), scene::m2dgr_thermal()}) {
+    const Undistorter undistorter(camera);
+    cv::RNG rng(3);
+    double worst = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Eigen::Vector2d pixel(rng.uniform(0.0, camera.width - 1.0),
+                                  rng.uniform(0.0, camera.height - 1.0));
+      Eigen::Vector2d exact;
+      ASSERT_TRUE(camera.normalised_from_pixel(pixel, exact));
+      worst = std::max(worst, (undistorter.normalised(pixel) - exact).norm());
+    }
+    EXPECT_LT(worst * camera.fx, 1e-6);  // [px]
+    EXPECT_TRUE(std::isnan(undistorter.normalised({-1.0, 3.0}).x()));
+    EXPECT_TRUE(std::isnan(undistorter.normalised({3.0, camera.height + 0.5}).y()));
+  }
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ struct Drive {
 };
 
 const Drive& drive() {
-  static const Drive d = [] {
+  static const Drive rendered = [] {
     Drive out;
     const auto visible_rays = scene::pixel_rays(scene::m2dgr_visible());
     const auto thermal_rays = scene::pixel_rays(scene::m2dgr_thermal());
@@ -58,7 +58,7 @@ const Drive& drive() {
     }
     return out;
   }();
-  return d;
+  return rendered;
 }
 
 FrontendConfig config_for(FrontendMode mode) {
