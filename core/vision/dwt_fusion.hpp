@@ -6,6 +6,16 @@
 // Eq. (8) as printed, max(|C_I|, |C_V|), would rectify every detail coefficient (all edges would
 // turn one-signed and the reconstruction would ring); the rule it names, "absolute-value maximum",
 // and the one implemented here, keeps the chosen coefficient with its sign.
+//
+// Noise-aware details (our change, on by default): eq. (8) compares raw magnitudes, so in flat
+// regions, where both images hold only noise, it picks whichever image is noisier and the fusion
+// inherits the worse noise of the two (a night-time visible image after seed 001's gamma and
+// CLAHE easily has 5x the thermal noise). With the images' noise levels sigma_v, sigma_t (seed
+// 002's noise metric) a detail coefficient counts as signal when it exceeds `significance` times
+// its image's sigma: where either image has signal, the one with more signal in units of its own
+// noise wins (|C_t| / sigma_t against |C_v| / sigma_v); where neither has, the quieter image's
+// coefficient is kept. Both images go through the same transform, so a band's noise scales with
+// its image's sigma and the one ratio serves every band.
 
 #include <opencv2/core/mat.hpp>
 
@@ -17,6 +27,8 @@ struct FusionConfig {
   Wavelet wavelet = Wavelet::kLeGall53;  ///< see dwt.hpp for the choice
   int levels = 2;                        ///< seed 000: two levels suffice
   double thermal_low_weight = 0.5;       ///< weight of the thermal low band, eq. (7): 0.5
+  bool noise_weighted = true;            ///< details by significance (above); false: eq. (8)
+  double significance = 3.0;             ///< a detail is signal above this x its sigma [-]
 };
 
 /// Eq. (7): out = w_t thermal + (1 - w_t) visible, element-wise (CV_32FC1, same size).
@@ -27,13 +39,21 @@ void fuse_low_band(const cv::Mat& visible, const cv::Mat& thermal, double therma
 /// the visible coefficient (CV_32FC1, same size; out may alias either input).
 void fuse_high_band(const cv::Mat& visible, const cv::Mat& thermal, cv::Mat& out);
 
+/// The noise-aware rule above, with each image's noise sigma (> 0) [grey].
+void fuse_high_band_noise_aware(const cv::Mat& visible, const cv::Mat& thermal,
+                                double visible_sigma, double thermal_sigma, double significance,
+                                cv::Mat& out);
+
 class DwtFusion {
  public:
   explicit DwtFusion(const FusionConfig& config);
 
   /// Fuses two registered grey images (CV_8UC1, same size; any size, padded internally by edge
-  /// replication) into `fused` (CV_8UC1).
-  void fuse(const cv::Mat& visible, const cv::Mat& thermal, cv::Mat& fused);
+  /// replication) into `fused` (CV_8UC1). `visible_noise`, `thermal_noise`: each image's noise
+  /// sigma [grey] for the noise-aware rule; eq. (8) when either is not positive or the rule is
+  /// off.
+  void fuse(const cv::Mat& visible, const cv::Mat& thermal, cv::Mat& fused,
+            double visible_noise = 0.0, double thermal_noise = 0.0);
 
   const FusionConfig& config() const { return config_; }
 

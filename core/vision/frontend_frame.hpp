@@ -91,7 +91,7 @@ enum class FrontendStep : std::uint8_t {
   kEnhance,   ///< visible: adaptive gamma + CLAHE, to grey
   kThermal,   ///< thermal: one remap (undistort, FOV, resample, register, rotate), 16->8 bit
   kFusion,    ///< DWT fusion
-  kQuality,   ///< gradient and noise metrics of every stream built
+  kQuality,   ///< gradient and noise metrics of every stream built (before and after fusion)
   kTracking,  ///< KLT, RANSAC, new corners (and lines when on)
   kDepth,     ///< lidar cloud to the kd-tree, depth per feature
 };

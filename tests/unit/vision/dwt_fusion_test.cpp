@@ -49,6 +49,42 @@ TEST(FusionRules, HighBandMayWriteIntoAnInput) {
   EXPECT_FLOAT_EQ(v.at<float>(2), 2.f);
 }
 
+TEST(FusionRules, NoiseAwareHighBandComparesSignificance) {
+  // Visible noise sigma 6, thermal 1, signal above 3 sigma.
+  const cv::Mat v = (cv::Mat_<float>(1, 5) << 6, -3, 30, 24, 40);
+  const cv::Mat t = (cv::Mat_<float>(1, 5) << 2, -2, 4, 0.5f, -9);
+  cv::Mat out;
+  fuse_high_band_noise_aware(v, t, 6.0, 1.0, 3.0, out);
+  EXPECT_FLOAT_EQ(out.at<float>(0), 2.f);   // neither is signal: the quieter (thermal) image
+  EXPECT_FLOAT_EQ(out.at<float>(1), -2.f);  // neither is signal
+  EXPECT_FLOAT_EQ(out.at<float>(2), 30.f);  // 5 sigma of visible beats 4 of thermal
+  EXPECT_FLOAT_EQ(out.at<float>(3), 24.f);  // 4 sigma of visible against 0.5: visible
+  EXPECT_FLOAT_EQ(out.at<float>(4), -9.f);  // 9 sigma of thermal beats 6.7 of visible
+}
+
+TEST(DwtFusion, NoiseAwareRuleKeepsTheQuieterImageInFlatRegions) {
+  // Both see a flat wall; the visible image is 8x noisier. Eq. (8) takes the larger coefficient,
+  // i.e. the visible noise; the noise-aware rule takes the quiet thermal detail.
+  const cv::Mat flat(240, 320, CV_8UC1, cv::Scalar(100));
+  const cv::Mat visible = scene::add_noise(flat, 8.0, 1), thermal = scene::add_noise(flat, 1.0, 2);
+  const auto noise_of = [&](const FusionConfig& config) {
+    DwtFusion fusion(config);
+    cv::Mat fused;
+    fusion.fuse(visible, thermal, fused, 8.0, 1.0);
+    cv::Scalar mean, sd;
+    cv::meanStdDev(fused, mean, sd);
+    return sd[0];
+  };
+  FusionConfig published;
+  published.noise_weighted = false;
+  const double literal = noise_of(published), weighted = noise_of({});
+  EXPECT_GT(literal, 5.0);  // the detail bands are the visible noise
+  // What is left: the averaged low band keeps half the visible image's coarse noise (its LL2
+  // band has sigma 3.4 here), the few visible coefficients above 3 sigma, and the thermal noise.
+  EXPECT_LT(weighted, 3.5);
+  EXPECT_LT(weighted, 0.45 * literal);
+}
+
 TEST(DwtFusion, IdenticalInputsComeBackUnchanged) {
   const cv::Mat image = scene::texture_image(640, 480, 0.01, 200, 20, 3);
   for (const Wavelet w : {Wavelet::kHaar, Wavelet::kLeGall53, Wavelet::kCdf97}) {

@@ -174,16 +174,19 @@ class RecordingProbe final : public FrontendStepProbe {
   std::vector<std::pair<FrontendStep, bool>> events;
 };
 
-TEST(VisualFrontend, ProbeSeesEveryStepOnceInOrder) {
+TEST(VisualFrontend, ProbeSeesEveryStepInOrder) {
   VisualFrontend frontend(config_for(FrontendMode::kFused));
   RecordingProbe probe;
   frontend.set_probe(&probe);
   FrontendFrame frame;
   ASSERT_EQ(frontend.process(input_for(0), frame), FrontendStatus::kOk);
   std::vector<std::pair<FrontendStep, bool>> expected;
+  // Quality of the input streams before the fusion (its noise-aware rule needs their noise),
+  // of the fusion after it.
   for (const FrontendStep s :
-       {FrontendStep::kEnhance, FrontendStep::kThermal, FrontendStep::kFusion,
-        FrontendStep::kQuality, FrontendStep::kTracking, FrontendStep::kDepth}) {
+       {FrontendStep::kEnhance, FrontendStep::kThermal, FrontendStep::kQuality,
+        FrontendStep::kFusion, FrontendStep::kQuality, FrontendStep::kTracking,
+        FrontendStep::kDepth}) {
     expected.emplace_back(s, true);
     expected.emplace_back(s, false);
   }
