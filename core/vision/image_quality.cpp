@@ -25,7 +25,10 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey, double min_noise_sigma
   gradient_row_.resize(static_cast<std::size_t>(w));
   response_row_.resize(static_cast<std::size_t>(w));
   const int low = config_.saturation_low, high = config_.saturation_high;
-  for (int r = 1; r < h - 1; ++r) {
+  const int row_step = std::max(1, config_.row_step);
+  std::uint64_t assessed = 0;
+  for (int r = 1; r < h - 1; r += row_step) {
+    assessed += static_cast<std::uint64_t>(w - 2);
     const std::uint8_t* up = grey.ptr<std::uint8_t>(r - 1);
     const std::uint8_t* mid = grey.ptr<std::uint8_t>(r);
     const std::uint8_t* down = grey.ptr<std::uint8_t>(r + 1);
@@ -57,7 +60,7 @@ ImageQuality QualityAssessor::assess(const cv::Mat& grey, double min_noise_sigma
 
   ImageQuality q;
   q.valid = true;
-  q.pixels = static_cast<std::uint32_t>((w - 2) * (h - 2));
+  q.pixels = static_cast<std::uint32_t>(assessed);
   // Noise first: the edge threshold depends on it. Threshold of h(): the smallest gradient bin
   // t with at least homogeneous_fraction of the pixels at G < t.
   const double want = std::clamp(config_.homogeneous_fraction, 0.0, 1.0) * q.pixels;

@@ -125,7 +125,11 @@ TEST(ImageQuality, EdgeCountUsesTheSlopeThreshold) {
     for (int c = 0; c < 32; ++c) ramp.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(7 * c);
   QualityConfig config;
   config.edge_gradient = 6;
+  config.row_step = 1;
   EXPECT_EQ(QualityAssessor(config).assess(ramp).edge_pixels, 30u * 30u);
+  config.row_step = 2;  // interior rows 1, 3, ..., 29
+  EXPECT_EQ(QualityAssessor(config).assess(ramp).pixels, 15u * 30u);
+  EXPECT_EQ(QualityAssessor(config).assess(ramp).edge_pixels, 15u * 30u);
   config.edge_gradient = 8;
   EXPECT_EQ(QualityAssessor(config).assess(ramp).edge_pixels, 0u);
 }
