@@ -6,9 +6,10 @@
 //
 // Seed 000 does not name its wavelet. Three are offered, all as lifting schemes (Daubechies &
 // Sweldens 1998), which are exactly invertible in any arithmetic and run in place:
-//   kHaar     (db1) orthonormal, 2 taps; cheapest, but abs-max fusion then switches sources in
-//             2^level-pixel blocks, whose corners the tracker would pick up;
-//   kLeGall53 (CDF 5/3, JPEG 2000 lossless) symmetric, 5/3 taps, no blocks (default);
+//   kHaar     (db1) orthonormal, 2 taps, the cheapest; the front end's default: it tracked best
+//             of the three on both synthetic drives (docs/frontend.md), its low band being a plain
+//             block mean that averages the noise down furthest;
+//   kLeGall53 (CDF 5/3, JPEG 2000 lossless) symmetric, 5/3 taps, no block seams;
 //   kCdf97    (CDF 9/7, JPEG 2000 lossy) smoothest, twice the lifting steps.
 // The separable transform runs rows first, then columns; the column pass works on whole rows as
 // vectors (o_i += a (e_i + e_i+1) for rows e, o), so both passes stream contiguous memory and

@@ -24,11 +24,11 @@
 namespace posed::vision {
 
 struct FusionConfig {
-  Wavelet wavelet = Wavelet::kLeGall53;  ///< see dwt.hpp for the choice
-  int levels = 2;                        ///< seed 000: two levels suffice
-  double thermal_low_weight = 0.5;       ///< weight of the thermal low band, eq. (7): 0.5
-  bool noise_weighted = true;            ///< details by significance (above); false: eq. (8)
-  double significance = 3.0;             ///< a detail is signal above this x its sigma [-]
+  Wavelet wavelet = Wavelet::kHaar;  ///< see dwt.hpp for the choice
+  int levels = 2;                    ///< seed 000: two levels suffice
+  double thermal_low_weight = 0.5;   ///< weight of the thermal low band, eq. (7): 0.5
+  bool noise_weighted = true;        ///< details by significance (above); false: eq. (8)
+  double significance = 3.0;         ///< a detail is signal above this x its sigma [-]
 };
 
 /// Eq. (7): out = w_t thermal + (1 - w_t) visible, element-wise (CV_32FC1, same size).

@@ -75,14 +75,18 @@ TEST(DwtFusion, NoiseAwareRuleKeepsTheQuieterImageInFlatRegions) {
     cv::meanStdDev(fused, mean, sd);
     return sd[0];
   };
-  FusionConfig published;
-  published.noise_weighted = false;
-  const double literal = noise_of(published), weighted = noise_of({});
-  EXPECT_GT(literal, 5.0);  // the detail bands are the visible noise
-  // What is left: the averaged low band keeps half the visible image's coarse noise (its LL2
-  // band has sigma 3.4 here), the few visible coefficients above 3 sigma, and the thermal noise.
-  EXPECT_LT(weighted, 3.5);
-  EXPECT_LT(weighted, 0.45 * literal);
+  for (const Wavelet w : {Wavelet::kHaar, Wavelet::kLeGall53, Wavelet::kCdf97}) {
+    FusionConfig published, aware;
+    published.wavelet = aware.wavelet = w;
+    published.noise_weighted = false;
+    const double literal = noise_of(published), weighted = noise_of(aware);
+    EXPECT_GT(literal, 5.0) << to_string(w);  // the detail bands are the visible noise
+    // What is left: the averaged low band keeps half of the visible image's coarse noise (the
+    // 2-level low-pass of sigma 8: 2 grey for Haar's block mean, 4 for 5/3), the few visible
+    // coefficients above 3 sigma, and the thermal noise.
+    EXPECT_LT(weighted, 3.5) << to_string(w);
+    EXPECT_LT(weighted, 0.45 * literal) << to_string(w);
+  }
 }
 
 TEST(DwtFusion, IdenticalInputsComeBackUnchanged) {
