@@ -2,6 +2,7 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -218,6 +219,17 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
         f.scans_used,        f.scans_rejected, f.scans_degenerate,      f.scans_skipped,
         f.reinitialisations, f.keyframes,      f.degenerate_directions, f.gyro_bias_radps,
         f.accel_bias_mps2};
+    const CameraFigures& cam = f.camera;
+    msg.camera.mode = std::string(cam.mode);
+    msg.camera.frames = cam.frames;
+    msg.camera.frames_unusable = cam.frames_unusable + cam.frames_without_imu;
+    msg.camera.features = cam.features;
+    msg.camera.depth_associated = cam.depth_associated;
+    msg.camera.match_success_rate = cam.match_success_rate();
+    for (std::size_t i = 0; i < 3; ++i) {
+      msg.camera.confidence[i] = cam.quality[i].valid ? cam.quality[i].confidence : 0.0;
+      msg.camera.omega[i] = cam.quality[i].valid ? cam.quality[i].omega : 0.0;
+    }
     msg.uptime_s = (st.stamp - started).seconds();
     std::string line = std::string(to_string(st.mode));
     for (const auto& s : st.streams) {
@@ -404,6 +416,22 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     std::printf("  IMU biases          gyro [%.5f %.5f %.5f] rad/s, accel [%.4f %.4f %.4f] m/s^2\n",
                 f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
                 f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());
+  }
+  if (!st.estimator.camera.mode.empty()) {
+    const CameraFigures& c = st.estimator.camera;
+    const double frames = static_cast<double>(std::max<std::uint64_t>(c.frames, 1));
+    std::printf(
+        "  camera front end    %s: %llu frames (%llu unusable, %llu without IMU), %.0f "
+        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features; mean "
+        "confidence visible %.2f, thermal %.2f, fused %.2f\n",
+        std::string(c.mode).c_str(), static_cast<unsigned long long>(c.frames),
+        static_cast<unsigned long long>(c.frames_unusable),
+        static_cast<unsigned long long>(c.frames_without_imu),
+        static_cast<double>(c.features_total) / frames, 100.0 * c.match_success_rate(),
+        c.features_total > 0
+            ? 100.0 * static_cast<double>(c.depth_total) / static_cast<double>(c.features_total)
+            : 0.0,
+        c.mean_confidence[0], c.mean_confidence[1], c.mean_confidence[2]);
   }
   if (!publisher)
     std::printf("  published           nothing (offline run, no DDS)\n");

@@ -1,6 +1,8 @@
 #include "daemon/pipeline/camera_stage.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 #include "daemon/pipeline/thread_policy.hpp"
 #include "drivers/common/log.hpp"
@@ -15,7 +17,9 @@ const config::CameraSection& camera_section(const config::PosedConfig& config, C
 }
 
 std::size_t CameraStage::pool_buffers(const config::PosedConfig& config) {
-  return static_cast<std::size_t>(config.queues.image_capacity) + 4;
+  // The queue, the frame being decoded, and what the fusion core's camera front end may hold:
+  // frames waiting for a partner (3) and pairs waiting for the IMU (up to 6).
+  return static_cast<std::size_t>(config.queues.image_capacity) + 12;
 }
 
 std::size_t CameraStage::frame_bytes(const config::CameraSection& section) {
@@ -64,7 +68,18 @@ camera::FrameDecoder* CameraStage::decoder_for(std::string_view wire_format, std
 void CameraStage::handle_frame(const drivers::RawChunk& chunk, std::span<const std::byte> pixels,
                                camera::FrameDecoder& decoder, std::optional<HostTime> exposure) {
   Image image;
-  const camera::DecodeStatus status = decoder.decode(pixels, sequence_++, pool_, image);
+  camera::DecodeStatus status = decoder.decode(pixels, sequence_++, pool_, image);
+  if (status == camera::DecodeStatus::kPoolEmpty && !source_.live()) {
+    // A recording must lose nothing (replays are deterministic): wait for the fusion core to
+    // return a buffer, as the queue would block, rather than drop the frame.
+    const auto give_up = std::chrono::steady_clock::now() + kReplayBlockTimeout;
+    while (status == camera::DecodeStatus::kPoolEmpty &&
+           std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      heartbeat_.beat();
+      status = decoder.decode(pixels, sequence_ - 1, pool_, image);
+    }
+  }
   // The frame is stamped even when it cannot be decoded: the clock must see every arrival.
   const HostTime stamp = exposure ? *exposure : clock_.stamp(chunk.host_receive);
   if (!exposure) log_clock_event(to_string(stream_), clock_.last_event());
