@@ -97,6 +97,19 @@ void Dwt2d::forward_rows(cv::Mat& a, int width, int height) {
   odd_.resize(static_cast<std::size_t>(n));
   float* e = even_.data();
   float* o = odd_.data();
+  if (wavelet_ == Wavelet::kHaar) {  // its two lifting steps and scaling in one pass
+    constexpr float k = 0.70710678118654752f;
+    for (int r = 0; r < height; ++r) {
+      float* p = a.ptr<float>(r);
+      for (int i = 0; i < n; ++i) {
+        e[i] = (p[2 * i] + p[2 * i + 1]) * k;
+        o[i] = (p[2 * i + 1] - p[2 * i]) * k;
+      }
+      std::memcpy(p, e, sizeof(float) * static_cast<std::size_t>(n));
+      std::memcpy(p + n, o, sizeof(float) * static_cast<std::size_t>(n));
+    }
+    return;
+  }
   for (int r = 0; r < height; ++r) {
     float* p = a.ptr<float>(r);
     for (int i = 0; i < n; ++i) {
@@ -126,6 +139,19 @@ void Dwt2d::inverse_rows(cv::Mat& a, int width, int height) {
   odd_.resize(static_cast<std::size_t>(n));
   float* e = even_.data();
   float* o = odd_.data();
+  if (wavelet_ == Wavelet::kHaar) {
+    constexpr float k = 0.70710678118654752f;
+    for (int r = 0; r < height; ++r) {
+      float* p = a.ptr<float>(r);
+      std::memcpy(e, p, sizeof(float) * static_cast<std::size_t>(n));
+      std::memcpy(o, p + n, sizeof(float) * static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i) {
+        p[2 * i] = (e[i] - o[i]) * k;
+        p[2 * i + 1] = (e[i] + o[i]) * k;
+      }
+    }
+    return;
+  }
   for (int r = 0; r < height; ++r) {
     float* p = a.ptr<float>(r);
     std::memcpy(e, p, sizeof(float) * static_cast<std::size_t>(n));
@@ -152,6 +178,23 @@ void Dwt2d::inverse_rows(cv::Mat& a, int width, int height) {
 void Dwt2d::forward_columns(cv::Mat& a, int width, int height) {
   const int n = height / 2;
   const std::size_t row_bytes = sizeof(float) * static_cast<std::size_t>(width);
+  if (wavelet_ == Wavelet::kHaar) {  // rows 2i, 2i+1 -> low row i, high row n+i
+    constexpr float k = 0.70710678118654752f;
+    for (int i = 0; i < n; ++i) {
+      const float* __restrict r0 = a.ptr<float>(2 * i);
+      const float* __restrict r1 = a.ptr<float>(2 * i + 1);
+      float* __restrict lo = scratch_.ptr<float>(i);
+      float* __restrict hi = scratch_.ptr<float>(n + i);
+      for (int c = 0; c < width; ++c) {
+        lo[c] = (r0[c] + r1[c]) * k;
+        hi[c] = (r1[c] - r0[c]) * k;
+      }
+    }
+    for (int r = 0; r < height; ++r) {
+      std::memcpy(a.ptr<float>(r), scratch_.ptr<float>(r), row_bytes);
+    }
+    return;
+  }
   // Even rows to the top half, odd rows to the bottom half; lifting on whole rows.
   for (int i = 0; i < n; ++i) {
     std::memcpy(scratch_.ptr<float>(i), a.ptr<float>(2 * i), row_bytes);
@@ -179,6 +222,23 @@ void Dwt2d::forward_columns(cv::Mat& a, int width, int height) {
 void Dwt2d::inverse_columns(cv::Mat& a, int width, int height) {
   const int n = height / 2;
   const std::size_t row_bytes = sizeof(float) * static_cast<std::size_t>(width);
+  if (wavelet_ == Wavelet::kHaar) {
+    constexpr float k = 0.70710678118654752f;
+    for (int r = 0; r < height; ++r) {
+      std::memcpy(scratch_.ptr<float>(r), a.ptr<float>(r), row_bytes);
+    }
+    for (int i = 0; i < n; ++i) {
+      const float* __restrict lo = scratch_.ptr<float>(i);
+      const float* __restrict hi = scratch_.ptr<float>(n + i);
+      float* __restrict r0 = a.ptr<float>(2 * i);
+      float* __restrict r1 = a.ptr<float>(2 * i + 1);
+      for (int c = 0; c < width; ++c) {
+        r0[c] = (lo[c] - hi[c]) * k;
+        r1[c] = (lo[c] + hi[c]) * k;
+      }
+    }
+    return;
+  }
   for (int r = 0; r < height; ++r) std::memcpy(scratch_.ptr<float>(r), a.ptr<float>(r), row_bytes);
   const auto e = [&](int i) { return scratch_.ptr<float>(i); };
   const auto o = [&](int i) { return scratch_.ptr<float>(n + i); };

@@ -11,7 +11,8 @@
 //             block mean that averages the noise down furthest;
 //   kLeGall53 (CDF 5/3, JPEG 2000 lossless) symmetric, 5/3 taps, no block seams;
 //   kCdf97    (CDF 9/7, JPEG 2000 lossy) smoothest, twice the lifting steps.
-// The separable transform runs rows first, then columns; the column pass works on whole rows as
+// Haar's two lifting steps and scaling run as one pass ((e + o)/sqrt 2, (o - e)/sqrt 2). The
+// separable transform runs rows first, then columns; the column pass works on whole rows as
 // vectors (o_i += a (e_i + e_i+1) for rows e, o), so both passes stream contiguous memory and
 // the inner loops vectorise. Borders use whole-sample symmetric extension.
 

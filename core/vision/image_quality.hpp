@@ -8,7 +8,7 @@
 // Gradient G of a pixel: |Sobel_x| + |Sobel_y|, divided by 8 so that a ramp of slope s grey/px
 // along an axis has G = s [grey/px] (a step of h grey gives G = h/2 beside it). A pixel is an
 // edge when G >= max(edge_gradient, edge_noise_factor sigma_n): a gradient the noise alone would
-// make is not an edge (on white noise G exceeds 2.5 sigma at ~0.001 % of the pixels), so noise
+// make is not an edge (on white noise G exceeds 2.5 sigma at ~0.01 % of the pixels), so noise
 // does not pass for texture.
 //   g = ln(1 + lambda n_e / n_t) / ln(1 + lambda)               (n_e edges of n_t pixels)
 // which is 0 without edges, 1 when every pixel is one, and rises faster for larger lambda (the

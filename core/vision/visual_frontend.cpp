@@ -1,6 +1,7 @@
 #include "core/vision/visual_frontend.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/vision/image_view.hpp"
 
@@ -44,8 +45,18 @@ FrontendInput make_input(const Image* visible, const Image* thermal) {
   return input;
 }
 
+namespace {
+const FrontendConfig& checked(const FrontendConfig& config) {
+  if (!config.visible_camera.valid() ||
+      (config.mode != FrontendMode::kVisible && !config.thermal_camera.valid())) {
+    throw std::invalid_argument("visual front end: camera intrinsics missing or invalid");
+  }
+  return config;
+}
+}  // namespace
+
 VisualFrontend::VisualFrontend(const FrontendConfig& config)
-    : config_(config),
+    : config_(checked(config)),
       visible_enhancer_(config.visible_enhance),
       thermal_enhancer_(config.thermal_enhance),
       fusion_(config.fusion),
@@ -141,11 +152,14 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     // its noise from the estimator, see image_quality.hpp).
     if (use_visible) out.quality.visible = quality_.assess(visible_grey_);
     if (use_thermal) {
+      // For 8-bit frames this is a view of the caller's buffer: enhance into our own.
       aligner_->native_grey(input.thermal, out.thermal_alignment, thermal_native_);
       if (config_.thermal_enhance.enabled) {
-        thermal_enhancer_.enhance_to_grey(thermal_native_, false, thermal_native_);
+        thermal_enhancer_.enhance_to_grey(thermal_native_, false, thermal_native_enhanced_);
+        out.quality.thermal = quality_.assess(thermal_native_enhanced_);
+      } else {
+        out.quality.thermal = quality_.assess(thermal_native_);
       }
-      out.quality.thermal = quality_.assess(thermal_native_);
     }
     end(FrontendStep::kQuality);
   }

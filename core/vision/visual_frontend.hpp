@@ -74,6 +74,7 @@ FrontendInput make_input(const Image* visible, const Image* thermal);
 
 class VisualFrontend {
  public:
+  /// Throws std::invalid_argument when a camera the mode uses has no valid intrinsics.
   explicit VisualFrontend(const FrontendConfig& config);
   ~VisualFrontend();
   VisualFrontend(const VisualFrontend&) = delete;
@@ -116,6 +117,7 @@ class VisualFrontend {
   FrontendStepProbe* probe_ = nullptr;
 
   cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, thermal_native_, fused_grey_;
+  cv::Mat thermal_native_enhanced_;
   // previous frame's features (id order) for the velocities
   std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> previous_;
   HostTime previous_stamp_;

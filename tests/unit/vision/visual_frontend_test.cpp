@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numbers>
 #include <opencv2/core.hpp>
+#include <stdexcept>
 
 #include "tests/unit/vision/synthetic_scene.hpp"
 
@@ -207,6 +208,28 @@ TEST(VisualFrontend, ReportsUnusableInput) {
   // Visible-only mode never looks at the thermal frame.
   VisualFrontend visible(config_for(FrontendMode::kVisible));
   EXPECT_EQ(visible.process(in, frame), FrontendStatus::kOk);
+}
+
+TEST(VisualFrontend, RefusesMissingIntrinsics) {
+  FrontendConfig config = config_for(FrontendMode::kFused);
+  config.thermal_camera = {};
+  EXPECT_THROW(VisualFrontend{config}, std::invalid_argument);
+  config.mode = FrontendMode::kVisible;  // does not need the thermal camera
+  EXPECT_NO_THROW(VisualFrontend{config});
+  config.visible_camera.fx = 0;
+  EXPECT_THROW(VisualFrontend{config}, std::invalid_argument);
+}
+
+TEST(VisualFrontend, ThermalEnhancementNeverWritesIntoTheInput) {
+  FrontendConfig config = config_for(FrontendMode::kThermal);
+  config.thermal_enhance.enabled = true;
+  VisualFrontend frontend(config);
+  FrontendInput in = input_for(0);
+  const cv::Mat before = in.thermal.clone();
+  FrontendFrame frame;
+  ASSERT_EQ(frontend.process(in, frame), FrontendStatus::kOk);
+  EXPECT_EQ(cv::norm(in.thermal, before, cv::NORM_INF), 0.0);
+  EXPECT_TRUE(frame.quality.thermal.valid);
 }
 
 TEST(VisualFrontend, WrapsCoreImagesWithoutCopying) {
