@@ -1,6 +1,7 @@
 #include "daemon/pipeline/pipeline.hpp"
 
 #include <cmath>
+#include <opencv2/core/utility.hpp>
 
 #include "core/estimator/fusion_core.hpp"
 #include "core/estimator/lio_estimator.hpp"
@@ -186,6 +187,10 @@ bool Pipeline::start(std::string& error) {
     // The device may appear later (USB enumeration, cable): the Source retries on read().
     POSED_LOG_WARN("IMU source not open yet: %s; retrying in the background", open_error.c_str());
   }
+  // OpenCV (the camera front end) would start a pool of worker threads of its own; the stages
+  // are the threads this pipeline runs (their priorities and CPUs are configured), so OpenCV
+  // runs sequentially on the fusion thread.
+  cv::setNumThreads(0);
   const HostTime now = drivers::host_now();
   for (auto& h : heartbeats_) h->reset(now);
   started_ = true;
