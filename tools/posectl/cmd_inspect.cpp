@@ -127,6 +127,9 @@ constexpr std::array kKinds = {
     InspectKind{"a9", "Handsfree A9 IMU raw serial bytes", inspect_a9},
     InspectKind{"velodyne", "Velodyne VLP-32C/VLP-16/HDL-32E pcap or pcapng", run_inspect_velodyne},
     InspectKind{"mcap", "MCAP recording: channels, counts, rates, gaps, errors", run_inspect_mcap},
+    InspectKind{"frontend",
+                "camera front end on a recording: visible, thermal and fused side by side",
+                run_inspect_frontend},
     InspectKind{"camera", "cameras: --list (V4L2, GenICam), or capture N frames to PNG",
                 run_inspect_camera},
 };

@@ -23,6 +23,7 @@ int run_echo(int argc, char** argv);
 int run_eval(int argc, char** argv);
 int run_sim(int argc, char** argv);
 int run_inspect_mcap(int argc, char** argv);
+int run_inspect_frontend(int argc, char** argv);
 int run_export(int argc, char** argv);
 int run_record(int argc, char** argv);
 int run_replay(int argc, char** argv);
