@@ -2,18 +2,16 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <thread>
 
 #include "daemon/build_info.hpp"
-#include "daemon/config/config_loader.hpp"
 #include "daemon/dds/publisher.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
@@ -55,15 +53,6 @@ struct PublishTally {
   /// the estimator publishes optimised states (so pose is not decimated from odom)
   bool have_optimised = false;
 };
-
-/// A file's contents for the recording's metadata ("" when unset or unreadable).
-std::string read_text_file(const std::string& path) {
-  if (path.empty()) return {};
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 /// Writes the map and keyframes the fusion core kept; false (logged) when there is none or a
 /// file cannot be written. `line` gets the summary line.
@@ -155,40 +144,13 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
   std::unique_ptr<drivers::recording::Recorder> recorder;
   if (!options.record_path.empty()) {
     recorder = std::make_unique<drivers::recording::Recorder>();
-    // Every channel carries the effective configuration: a recording says how it was made.
-    const std::string effective_config = config::print_config(config);
     drivers::recording::RecorderOptions recorder_options;
     recorder_options.host_to_wall = to_wall;
     if (!recorder->open(options.record_path, recorder_options, error)) {
       POSED_LOG_ERROR("cannot record: %s", error.c_str());
       return 1;
     }
-    built.sources.imu = std::make_unique<pipeline::RecordingTap>(
-        std::move(built.sources.imu), *recorder,
-        std::map<std::string, std::string>{{"posed.imu.source", config.imu.source},
-                                           {"posed.imu.device", config.imu.serial_device},
-                                           {"posed.config", effective_config}});
-    if (built.sources.lidar) {
-      built.sources.lidar = std::make_unique<pipeline::RecordingTap>(
-          std::move(built.sources.lidar), *recorder,
-          std::map<std::string, std::string>{
-              {"posed.lidar.address", config.lidar.address},
-              {"posed.lidar.calibration", config.lidar.calibration},
-              {"posed.lidar.calibration_text", read_text_file(config.lidar.calibration)},
-              {"posed.config", effective_config}});
-    }
-    for (const CameraStream stream : {CameraStream::kVisible, CameraStream::kThermal}) {
-      std::unique_ptr<drivers::Source>& camera = built.sources.camera(stream);
-      if (!camera) continue;
-      const config::CameraSection& section = pipeline::camera_section(config, stream);
-      const std::string prefix = "posed." + std::string(to_string(stream)) + ".";
-      camera = std::make_unique<pipeline::RecordingTap>(
-          std::move(camera), *recorder,
-          std::map<std::string, std::string>{{prefix + "device", section.device},
-                                             {prefix + "source", section.source},
-                                             {prefix + "format", section.format},
-                                             {"posed.config", effective_config}});
-    }
+    pipeline::tap_sources(built.sources, *recorder, config);
     POSED_LOG_INFO("recording raw streams and poses to %s", options.record_path.c_str());
   }
 
@@ -257,6 +219,17 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
         f.scans_used,        f.scans_rejected, f.scans_degenerate,      f.scans_skipped,
         f.reinitialisations, f.keyframes,      f.degenerate_directions, f.gyro_bias_radps,
         f.accel_bias_mps2};
+    const CameraFigures& cam = f.camera;
+    msg.camera.mode = std::string(cam.mode);
+    msg.camera.frames = cam.frames;
+    msg.camera.frames_unusable = cam.frames_unusable + cam.frames_without_imu;
+    msg.camera.features = cam.features;
+    msg.camera.depth_associated = cam.depth_associated;
+    msg.camera.match_success_rate = cam.match_success_rate();
+    for (std::size_t i = 0; i < 3; ++i) {
+      msg.camera.confidence[i] = cam.quality[i].valid ? cam.quality[i].confidence : 0.0;
+      msg.camera.omega[i] = cam.quality[i].valid ? cam.quality[i].omega : 0.0;
+    }
     msg.uptime_s = (st.stamp - started).seconds();
     std::string line = std::string(to_string(st.mode));
     for (const auto& s : st.streams) {
@@ -443,6 +416,22 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     std::printf("  IMU biases          gyro [%.5f %.5f %.5f] rad/s, accel [%.4f %.4f %.4f] m/s^2\n",
                 f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
                 f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());
+  }
+  if (!st.estimator.camera.mode.empty()) {
+    const CameraFigures& c = st.estimator.camera;
+    const double frames = static_cast<double>(std::max<std::uint64_t>(c.frames, 1));
+    std::printf(
+        "  camera front end    %s: %llu frames (%llu unusable, %llu without IMU), %.0f "
+        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features; mean "
+        "confidence visible %.2f, thermal %.2f, fused %.2f\n",
+        std::string(c.mode).c_str(), static_cast<unsigned long long>(c.frames),
+        static_cast<unsigned long long>(c.frames_unusable),
+        static_cast<unsigned long long>(c.frames_without_imu),
+        static_cast<double>(c.features_total) / frames, 100.0 * c.match_success_rate(),
+        c.features_total > 0
+            ? 100.0 * static_cast<double>(c.depth_total) / static_cast<double>(c.features_total)
+            : 0.0,
+        c.mean_confidence[0], c.mean_confidence[1], c.mean_confidence[2]);
   }
   if (!publisher)
     std::printf("  published           nothing (offline run, no DDS)\n");

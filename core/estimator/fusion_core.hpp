@@ -8,17 +8,57 @@
 // Sources are recordings; live, in arrival order, which differs from stamp order by at most the
 // queues' latency — an estimator must tolerate that (e.g. through MeasurementGate).
 
+#include <array>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
 #include "core/estimator/nav_state.hpp"
 #include "core/estimator/strapdown.hpp"
+#include "core/lidar/scan_motion.hpp"
 #include "core/measurements.hpp"
 
 namespace posed {
 
 /// What an estimator reports in rt/posed/status and the exit summary.
+/// One image stream's quality in the last frame (seed 002): what the back end weighs it by.
+struct StreamQualityFigures {
+  bool valid = false;          ///< the stream was assessed
+  double gradient_metric = 0;  ///< g, share of edge pixels mapped to [0..1]
+  double noise_sigma = 0;      ///< sigma_n [grey]
+  double confidence = 0;       ///< omega_min / omega (0..1]
+  double omega = 0;            ///< covariance scale of the stream's factors [-]
+};
+
+/// What a camera front end (core/vision's visual-thermal front end) did; `mode` names it.
+struct CameraFigures {
+  std::string_view mode;                 ///< "visible", "thermal" or "fused"; empty: no front end
+  std::uint64_t frames = 0;              ///< visible frame events the front end processed [1]
+  std::uint64_t frames_unusable = 0;     ///< events the mode could not use (no partner, bad image)
+  std::uint64_t frames_without_imu = 0;  ///< events dropped: no IMU around their stamps [1]
+  std::uint64_t previous_total = 0;      ///< features carried into frames, summed [1]
+  std::uint64_t inliers_total = 0;       ///< of those, tracked and RANSAC inliers, summed [1]
+  std::uint64_t extracted_total = 0;     ///< new features detected, summed [1]
+  std::uint64_t features_total = 0;      ///< features output, summed [1]
+  std::uint64_t depth_total = 0;         ///< of those, with lidar depth, summed [1]
+  int features = 0;                      ///< in the last frame [1]
+  int depth_associated = 0;              ///< in the last frame [1]
+  int lidar_points = 0;                  ///< in the last frame's depth tree [1]
+  /// visible, thermal, fused (by vision::FrontendMode order) in the last frame
+  std::array<StreamQualityFigures, 3> quality{};
+  /// means of confidence over the frames where the stream was assessed (visible, thermal, fused)
+  std::array<double, 3> mean_confidence{};
+  std::array<std::uint64_t, 3> quality_frames{};  ///< frames each mean is over [1]
+
+  /// seed 001's match success rate over the run: inliers over features carried in [0..1]
+  double match_success_rate() const {
+    return previous_total > 0
+               ? static_cast<double>(inliers_total) / static_cast<double>(previous_total)
+               : 0.0;
+  }
+};
+
 struct FusionFigures {
   std::uint64_t scans_used = 0;         ///< scans whose match entered the estimate [1]
   std::uint64_t scans_rejected = 0;     ///< matches refused (too few points, implausible jump) [1]
@@ -29,6 +69,8 @@ struct FusionFigures {
   int degenerate_directions = 0;        ///< in the last scan's match [1]
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  ///< current estimate [rad/s]
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]
+  /// the camera front end's figures (mode empty without one)
+  CameraFigures camera;
 };
 
 /// The map an estimator built over a run, for export at its end (posed --save-map).
@@ -40,6 +82,15 @@ struct MapExport {
   std::vector<Eigen::Vector3f> points_map_m;  ///< map frame [m]
   double voxel_m = 0;                         ///< resolution the points were merged at [m]
   std::vector<Keyframe> keyframes;
+};
+
+/// The newest scan a core matched, deskewed to its end, and where it was: what a camera front
+/// end needs for lidar depth. The points stay valid until the core's next add_scan().
+struct MatchedScan {
+  std::uint64_t index = 0;  ///< counts matched scans from 1: a new value is a new scan [1]
+  HostTime stamp;           ///< the scan's end, where the points are deskewed to
+  Eigen::Isometry3d T_map_lidar = Eigen::Isometry3d::Identity();
+  std::span<const lidar::ScanPoint> points_lidar;  ///< in the lidar frame at `stamp`
 };
 
 class FusionCore {
@@ -63,6 +114,11 @@ class FusionCore {
   /// Appends the map and keyframe poses built so far; cores without a map (IMU-only) add
   /// nothing, and so does a core not asked to keep one (LioConfig::keep_map).
   virtual void export_map(MapExport& out) const { (void)out; }
+  /// The newest matched scan; false for a core without a lidar or before its first match.
+  virtual bool latest_matched_scan(MatchedScan& out) const {
+    (void)out;
+    return false;
+  }
 };
 
 /// IMU-only dead reckoning (Strapdown): the core for configurations without aiding sensors.

@@ -93,6 +93,7 @@ class LioEstimator final : public FusionCore {
   }
   FusionFigures figures() const override;
   void export_map(MapExport& out) const override;
+  bool latest_matched_scan(MatchedScan& out) const override;
 
   const lidar::LidarOdometry& lidar_odometry() const { return lidar_; }
   const SlidingWindow& window() const { return window_; }
@@ -139,6 +140,7 @@ class LioEstimator final : public FusionCore {
   lidar::LidarOdometry lidar_;
   lidar::MapCloud map_cloud_;  ///< whole-run map, only when config_.keep_map
   std::vector<MapExport::Keyframe> map_keyframes_;
+  std::uint64_t matched_scans_ = 0;  ///< scans whose match was used; indexes MatchedScan [1]
   lidar::ScanMotion motion_;
   SlidingWindow window_;
   /// the state published poses are propagated from (the newest optimised one)

@@ -112,6 +112,24 @@ struct ExtrinsicsSection {
   Transform4 T_cam_depth{};
 };
 
+struct FrontendSection {
+  std::string mode = "fused";  ///< off | visible | thermal | fused
+  bool enhance_visible = true;
+  double gamma_target_mean = 0.5;                 ///< [0..1]
+  double clahe_clip_limit = 2.0;                  ///< [x uniform bin]
+  std::string thermal_registration = "infinity";  ///< infinity | plane | fov_crop
+  double thermal_plane_depth_m = 10;              ///< [m]
+  bool rotation_compensation = true;
+  std::string wavelet = "haar";  ///< haar | legall53 | cdf97
+  int max_features = 300;
+  double min_feature_distance_px = 20;  ///< [px]
+  double ransac_threshold_px = 1;       ///< [px]
+  bool lines = false;
+  double depth_window_s = 1;  ///< [s]
+  int depth_points_per_scan = 20000;
+  double depth_max_span_m = 2;  ///< [m]
+};
+
 struct EstimatorSection {
   double init_static_s = 1.0;         ///< IMU averaged for the gravity alignment [s]
   double init_max_gyro_radps = 0.05;  ///< above this the rig is not static [rad/s]
@@ -169,6 +187,7 @@ struct PosedConfig {
   SyncSection sync;
   ExtrinsicsSection extrinsics;
   EstimatorSection estimator;
+  FrontendSection frontend;
   ThreadsSection threads;
   QueuesSection queues;
   WatchdogSection watchdog;

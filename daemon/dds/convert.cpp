@@ -73,6 +73,17 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
     out.estimator.gyro_bias_radps[i] = e.gyro_bias_radps[i];
     out.estimator.accel_bias_mps2[i] = e.accel_bias_mps2[i];
   }
+  const CameraStatusMessage& cam = msg.camera;
+  out.camera.mode = c_str(cam.mode);
+  out.camera.frames = cam.frames;
+  out.camera.frames_unusable = cam.frames_unusable;
+  out.camera.features = cam.features;
+  out.camera.depth_associated = cam.depth_associated;
+  out.camera.match_success_rate = cam.match_success_rate;
+  for (std::size_t i = 0; i < 3; ++i) {
+    out.camera.confidence[i] = cam.confidence[i];
+    out.camera.omega[i] = cam.omega[i];
+  }
   out.uptime_s = msg.uptime_s;
   out.summary = c_str(msg.summary);
   if (streams.size() < msg.streams.size()) streams.resize(msg.streams.size());
@@ -136,6 +147,17 @@ StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
   for (int i = 0; i < 3; ++i) {
     e.gyro_bias_radps[i] = in.estimator.gyro_bias_radps[i];
     e.accel_bias_mps2[i] = in.estimator.accel_bias_mps2[i];
+  }
+  CameraStatusMessage& cam = msg.camera;
+  cam.mode = to_string(in.camera.mode);
+  cam.frames = in.camera.frames;
+  cam.frames_unusable = in.camera.frames_unusable;
+  cam.features = in.camera.features;
+  cam.depth_associated = in.camera.depth_associated;
+  cam.match_success_rate = in.camera.match_success_rate;
+  for (std::size_t i = 0; i < 3; ++i) {
+    cam.confidence[i] = in.camera.confidence[i];
+    cam.omega[i] = in.camera.omega[i];
   }
   msg.uptime_s = in.uptime_s;
   msg.summary = to_string(in.summary);

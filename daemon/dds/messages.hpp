@@ -119,6 +119,18 @@ struct EstimatorStatusMessage {
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< [m/s^2]
 };
 
+/// posed_msgs/CameraStatus: the camera front end's figures.
+struct CameraStatusMessage {
+  std::string mode;                    ///< "visible", "thermal", "fused"; empty: none
+  std::uint64_t frames = 0;            ///< [count]
+  std::uint64_t frames_unusable = 0;   ///< [count]
+  std::int32_t features = 0;           ///< in the last frame [count]
+  std::int32_t depth_associated = 0;   ///< in the last frame [count]
+  double match_success_rate = 0;       ///< since start [0..1]
+  std::array<double, 3> confidence{};  ///< visible, thermal, fused in the last frame [0..1]
+  std::array<double, 3> omega{};       ///< visible, thermal, fused in the last frame [-]
+};
+
 /// posed_msgs/Status: published at 1 Hz.
 struct StatusMessage {
   /// time of the report (wall clock, UNIX epoch) [ns]
@@ -128,6 +140,7 @@ struct StatusMessage {
   /// estimator mode, e.g. "strapdown", "lidar_inertial"
   std::string estimator_mode;
   EstimatorStatusMessage estimator;
+  CameraStatusMessage camera;
   /// time since the daemon started [s]
   double uptime_s = 0.0;
   /// one-line human-readable summary

@@ -1,6 +1,8 @@
 #include "daemon/pipeline/camera_stage.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 #include "daemon/pipeline/thread_policy.hpp"
 #include "drivers/common/log.hpp"
@@ -15,7 +17,9 @@ const config::CameraSection& camera_section(const config::PosedConfig& config, C
 }
 
 std::size_t CameraStage::pool_buffers(const config::PosedConfig& config) {
-  return static_cast<std::size_t>(config.queues.image_capacity) + 4;
+  // The queue, the frame being decoded, and what the fusion core's camera front end may hold:
+  // frames waiting for a partner (3) and pairs waiting for the IMU (up to 6).
+  return static_cast<std::size_t>(config.queues.image_capacity) + 12;
 }
 
 std::size_t CameraStage::frame_bytes(const config::CameraSection& section) {
@@ -38,27 +42,47 @@ CameraStage::CameraStage(const config::PosedConfig& config, CameraStream stream,
       pool_(pool_buffers(config), frame_bytes(section_)),
       clock_(section_) {}
 
-camera::FrameDecoder* CameraStage::decoder_for(std::string_view wire_format) {
-  if (decoder_ && wire_format == decoder_format_) return decoder_.get();
+camera::FrameDecoder* CameraStage::decoder_for(std::string_view wire_format, std::uint32_t width,
+                                               std::uint32_t height, std::uint32_t stride_bytes) {
+  if (decoder_ && wire_format == decoder_format_ && width == decoder_width_ &&
+      height == decoder_height_ && stride_bytes == decoder_stride_) {
+    return decoder_.get();
+  }
   const std::optional<camera::WireFormat> format = camera::wire_format_from_string(wire_format);
   if (!format) return nullptr;
   camera::FrameDecoderConfig c;
   c.format = *format;
-  c.width = static_cast<std::uint32_t>(section_.width);
-  c.height = static_cast<std::uint32_t>(section_.height);
+  c.width = width;
+  c.height = height;
+  c.stride_bytes = stride_bytes;
   // A thermal camera's MJPEG is grey; the fusion core's thermal path wants one channel.
   c.mjpeg_to_mono8 = stream_ == CameraStream::kThermal;
   decoder_ = std::make_unique<camera::FrameDecoder>(c);
   decoder_format_ = std::string(wire_format);
+  decoder_width_ = width;
+  decoder_height_ = height;
+  decoder_stride_ = stride_bytes;
   return decoder_.get();
 }
 
-void CameraStage::handle_frame(const drivers::RawChunk& chunk, camera::FrameDecoder& decoder) {
+void CameraStage::handle_frame(const drivers::RawChunk& chunk, std::span<const std::byte> pixels,
+                               camera::FrameDecoder& decoder, std::optional<HostTime> exposure) {
   Image image;
-  const camera::DecodeStatus status = decoder.decode(chunk.bytes, sequence_++, pool_, image);
+  camera::DecodeStatus status = decoder.decode(pixels, sequence_++, pool_, image);
+  if (status == camera::DecodeStatus::kPoolEmpty && !source_.live()) {
+    // A recording must lose nothing (replays are deterministic): wait for the fusion core to
+    // return a buffer, as the queue would block, rather than drop the frame.
+    const auto give_up = std::chrono::steady_clock::now() + kReplayBlockTimeout;
+    while (status == camera::DecodeStatus::kPoolEmpty &&
+           std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      heartbeat_.beat();
+      status = decoder.decode(pixels, sequence_ - 1, pool_, image);
+    }
+  }
   // The frame is stamped even when it cannot be decoded: the clock must see every arrival.
-  const HostTime stamp = clock_.stamp(chunk.host_receive);
-  log_clock_event(to_string(stream_), clock_.last_event());
+  const HostTime stamp = exposure ? *exposure : clock_.stamp(chunk.host_receive);
+  if (!exposure) log_clock_event(to_string(stream_), clock_.last_event());
   switch (status) {
     case camera::DecodeStatus::kOk:
     case camera::DecodeStatus::kPartial:
@@ -92,12 +116,16 @@ void CameraStage::run() {
       }
       continue;
     }
-    camera::FrameDecoder* decoder = decoder_for(format);
-    if (decoder == nullptr) {
+    if (format.starts_with(drivers::wire::kRos1Prefix)) {
+      handle_ros1_image(chunk, format);
+    } else if (camera::FrameDecoder* decoder =
+                   decoder_for(format, static_cast<std::uint32_t>(section_.width),
+                               static_cast<std::uint32_t>(section_.height), 0)) {
+      handle_frame(chunk, chunk.bytes, *decoder, std::nullopt);
+    } else {
       reader.undecodable(chunk);
       continue;
     }
-    handle_frame(chunk, *decoder);
     if (++frames % 16 == 0) counters_.publish_clock(clock_.status());
   }
   counters_.publish_clock(clock_.status());

@@ -5,6 +5,8 @@
 // the Source's pixel format, channel 1 the D4xx metadata that precedes each frame.
 
 #include <memory>
+#include <optional>
+#include <span>
 
 #include "core/payload_pool.hpp"
 #include "core/spsc_queue.hpp"
@@ -35,9 +37,16 @@ class CameraStage {
   static std::size_t frame_bytes(const config::CameraSection& section);
 
  private:
-  /// The decoder for a pixel format; null (counted as undecodable) for one posed cannot decode.
-  drivers::camera::FrameDecoder* decoder_for(std::string_view wire_format);
-  void handle_frame(const drivers::RawChunk& chunk, drivers::camera::FrameDecoder& decoder);
+  /// The decoder for a pixel format at a size; null (counted as undecodable) for one posed
+  /// cannot decode. Made again only when format or geometry change.
+  drivers::camera::FrameDecoder* decoder_for(std::string_view wire_format, std::uint32_t width,
+                                             std::uint32_t height, std::uint32_t stride_bytes);
+  /// Decodes and queues one frame. `exposure`: the frame's stamp when its source already put it
+  /// on the host clock; otherwise the camera clock stamps it from `chunk.host_receive`.
+  void handle_frame(const drivers::RawChunk& chunk, std::span<const std::byte> pixels,
+                    drivers::camera::FrameDecoder& decoder, std::optional<HostTime> exposure);
+  /// sensor_msgs/Image and CompressedImage from an imported ROS 1 bag (camera_stage_ros1.cpp).
+  void handle_ros1_image(const drivers::RawChunk& chunk, std::string_view wire_format);
 
   const config::PosedConfig& config_;
   CameraStream stream_;
@@ -51,6 +60,7 @@ class CameraStage {
   PayloadPool pool_;
   CameraClock clock_;
   std::string decoder_format_;
+  std::uint32_t decoder_width_ = 0, decoder_height_ = 0, decoder_stride_ = 0;
   std::unique_ptr<drivers::camera::FrameDecoder> decoder_;
   std::uint64_t sequence_ = 0;
 };

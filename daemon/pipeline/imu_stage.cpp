@@ -41,8 +41,11 @@ void ImuStage::on_a9_frame(const a9::A9Frame& frame, HostTime arrival) {
   const HostTime stamp = clock_.map_raw(frame.sensor.counter_us, arrival);
   log_clock_event("imu", clock_.last_event());
   const DeviceTime device_stamp = clock_.status().last_device_stamp;
-  const PushResult r =
-      queue_.push(ImuItem{a9::to_imu_sample(frame.sensor, mounting_, stamp, device_stamp), false});
+  push(a9::to_imu_sample(frame.sensor, mounting_, stamp, device_stamp));
+}
+
+void ImuStage::push(const ImuSample& sample) {
+  const PushResult r = queue_.push(ImuItem{sample, false});
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
   pushed_ = true;
@@ -71,7 +74,13 @@ void ImuStage::run() {
   SourceReader reader("imu", source_, heartbeat_, counters_);
   const auto on_frame = [&](const a9::A9Frame& frame) { on_a9_frame(frame, chunk.host_receive); };
   while (reader.next(chunk)) {
-    if (reader.wire_format(chunk) != drivers::wire::kA9Serial) {
+    const std::string_view format = reader.wire_format(chunk);
+    if (format == drivers::wire::kRos1Imu) {
+      on_ros1_imu(chunk);
+      publish_progress();
+      continue;
+    }
+    if (format != drivers::wire::kA9Serial) {
       reader.undecodable(chunk);
       continue;
     }

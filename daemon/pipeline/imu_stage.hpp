@@ -1,6 +1,7 @@
 #pragma once
 // The IMU stage (one thread): Source -> decoder chosen by the channel's wire format -> ClockSync
-// (device stamp -> host clock) -> the IMU queue to the fusion stage.
+// (device stamp -> host clock) -> the IMU queue to the fusion stage. Wire formats: the A9's
+// serial frames, and sensor_msgs/Imu from an imported ROS 1 bag (imu_stage_ros1.cpp).
 
 #include "core/spsc_queue.hpp"
 #include "core/sync/clock_sync.hpp"
@@ -21,6 +22,9 @@ class ImuStage {
 
  private:
   void on_a9_frame(const drivers::a9::A9Frame& frame, HostTime arrival);
+  /// One serialized sensor_msgs/Imu (imu_stage_ros1.cpp).
+  void on_ros1_imu(const drivers::RawChunk& chunk);
+  void push(const ImuSample& sample);
   void count_malformed();
   void publish_progress();
 

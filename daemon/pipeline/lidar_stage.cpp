@@ -8,6 +8,16 @@ namespace posed::pipeline {
 
 namespace velodyne = drivers::velodyne;
 
+std::vector<double> LidarStage::ring_elevations(const velodyne::Calibration& calibration) {
+  // Without a calibration file the rig's sensor, the VLP-32C, as its manual tables it.
+  const velodyne::Calibration c = calibration.lasers.empty()
+                                      ? velodyne::builtin_calibration(velodyne::ProductId::kVlp32c)
+                                      : calibration;
+  std::vector<double> out;
+  for (const auto& laser : c.lasers) out.push_back(laser.vert_correction_rad);
+  return out;
+}
+
 std::size_t LidarStage::pool_buffers(const config::PosedConfig& config) {
   return static_cast<std::size_t>(config.queues.scan_capacity) + 4;
 }
@@ -23,6 +33,7 @@ LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration 
       heartbeat_(heartbeat),
       counters_(counters),
       scan_counters_(scan_counters),
+      ring_elevations_rad_(ring_elevations(calibration)),
       pool_(pool_buffers(config),
             velodyne::max_points_per_scan(config.lidar.rpm) * sizeof(LidarPoint)),
       builder_(std::move(calibration),
@@ -36,16 +47,20 @@ LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration 
                                      config.lidar.cut_azimuth_deg * 100)}},
                pool_) {}
 
+void LidarStage::push_scan(LidarScan&& scan) {
+  scan_counters_.scans.fetch_add(1, std::memory_order_relaxed);
+  scan_counters_.points.fetch_add(scan.point_count, std::memory_order_relaxed);
+  const PushResult r = queue_.push(ScanItem{std::move(scan), false});
+  if (r == PushResult::kRejectedFull || r == PushResult::kRejectedTimeout ||
+      r == PushResult::kPushedDropped) {
+    counters_.dropped.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
 void LidarStage::forward_scans() {
   bool pushed = false;
   while (builder_.pop(assembled_)) {
-    scan_counters_.scans.fetch_add(1, std::memory_order_relaxed);
-    scan_counters_.points.fetch_add(assembled_.scan.point_count, std::memory_order_relaxed);
-    const PushResult r = queue_.push(ScanItem{std::move(assembled_.scan), false});
-    if (r == PushResult::kRejectedFull || r == PushResult::kRejectedTimeout ||
-        r == PushResult::kPushedDropped) {
-      counters_.dropped.fetch_add(1, std::memory_order_relaxed);
-    }
+    push_scan(std::move(assembled_.scan));
     pushed = true;
   }
   if (pushed) consumer_.signal();
@@ -80,13 +95,15 @@ void LidarStage::run() {
       handle_data(chunk);
     } else if (format == drivers::wire::kVelodynePosition) {
       handle_position(chunk);
+    } else if (format == drivers::wire::kRos1PointCloud2) {
+      handle_ros1_cloud(chunk);
     } else {
       reader.undecodable(chunk);
     }
   }
   builder_.flush();
   forward_scans();
-  counters_.publish_clock(builder_.clock().status());
+  counters_.publish_clock(cloud_decoder_ ? cloud_clock_ : builder_.clock().status());
   queue_.push(ScanItem{{}, true});
   consumer_.signal();
 }

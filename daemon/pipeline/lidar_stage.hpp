@@ -1,7 +1,8 @@
 #pragma once
 // The lidar stage (one thread): Source -> Velodyne ScanBuilder (packet decoder, ClockSync from µs
 // past the hour onto the host clock, scan assembler into pool buffers) -> the scan queue to the
-// fusion stage. Position packets (channel 1) report the PPS state.
+// fusion stage. Position packets (channel 1) report the PPS state. Clouds imported from a ROS 1
+// bag (sensor_msgs/PointCloud2) become scans directly (lidar_stage_ros1.cpp).
 
 #include <memory>
 
@@ -12,6 +13,7 @@
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 #include "drivers/common/source.hpp"
+#include "drivers/recording/ros1_cloud_scan.hpp"
 #include "drivers/velodyne/calibration.hpp"
 #include "drivers/velodyne/scan_builder.hpp"
 
@@ -34,10 +36,15 @@ class LidarStage {
 
   /// Pool buffers: the scans queued, the one being assembled and a few held by the fusion core.
   static std::size_t pool_buffers(const config::PosedConfig& config);
+  /// Beam elevations of `calibration` (the VLP-32C's when empty), for clouds without rings [rad].
+  static std::vector<double> ring_elevations(const drivers::velodyne::Calibration& calibration);
 
  private:
   void handle_position(const drivers::RawChunk& chunk);
   void handle_data(const drivers::RawChunk& chunk);
+  /// One serialized sensor_msgs/PointCloud2 (lidar_stage_ros1.cpp).
+  void handle_ros1_cloud(const drivers::RawChunk& chunk);
+  void push_scan(LidarScan&& scan);
   void forward_scans();
 
   const config::PosedConfig& config_;
@@ -48,8 +55,14 @@ class LidarStage {
   StreamCounters& counters_;
   LidarScanCounters& scan_counters_;
 
+  /// beam elevations by ring for clouds without a ring field [rad]; before builder_, which
+  /// takes the calibration they come from
+  std::vector<double> ring_elevations_rad_;
   PayloadPool pool_;
   drivers::velodyne::ScanBuilder builder_;
+  std::unique_ptr<drivers::recording::ros1::CloudScanDecoder> cloud_decoder_;
+  ClockSyncStatus cloud_clock_;
+  bool reported_cloud_layout_ = false;
   drivers::velodyne::AssembledScan assembled_;
   bool reported_pps_ = false;
 };

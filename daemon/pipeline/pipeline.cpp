@@ -1,11 +1,14 @@
 #include "daemon/pipeline/pipeline.hpp"
 
 #include <cmath>
+#include <opencv2/core/utility.hpp>
 
 #include "core/estimator/fusion_core.hpp"
 #include "core/estimator/lio_estimator.hpp"
+#include "core/fusion/camera_aided_core.hpp"
 #include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/estimator_config.hpp"
+#include "daemon/pipeline/frontend_config.hpp"
 #include "daemon/pipeline/fusion_stage.hpp"
 #include "daemon/pipeline/imu_stage.hpp"
 #include "daemon/pipeline/lidar_stage.hpp"
@@ -36,6 +39,25 @@ std::unique_ptr<FusionCore> make_core(const config::PosedConfig& c, bool have_li
     return std::make_unique<estimator::LioEstimator>(lio);
   }
   return make_strapdown_core(strapdown_config(c));
+}
+
+/// `inner` with the camera front end beside it when a camera runs and the front end is on.
+std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
+                                         const config::PosedConfig& c, bool has_visible,
+                                         bool has_thermal, bool in_stamp_order,
+                                         const PipelineOutputs& outputs,
+                                         const fusion::CameraAidedCore*& camera_core) {
+  camera_core = nullptr;
+  if ((!has_visible && !has_thermal) || c.frontend.mode == "off") return inner;
+  std::string note;
+  fusion::CameraFrontEndConfig cameras =
+      camera_front_end_config(c, has_visible, has_thermal, in_stamp_order, note);
+  if (!note.empty()) POSED_LOG_WARN("frontend: %s", note.c_str());
+  cameras.compare_modes = outputs.frontend_compare_modes;
+  auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras);
+  core->cameras().set_observer(outputs.frontend_observer);
+  camera_core = core.get();
+  return core;
 }
 
 }  // namespace
@@ -134,7 +156,10 @@ bool Pipeline::start(std::string& error) {
     if (s != nullptr && s->live()) in_stamp_order = false;
   }
   fusion_stage_ = std::make_unique<FusionStage>(
-      config_, make_core(config_, sources_.lidar != nullptr, outputs_.keep_map),
+      config_,
+      with_cameras(make_core(config_, sources_.lidar != nullptr, outputs_.keep_map), config_,
+                   sources_.visible != nullptr, sources_.thermal != nullptr, in_stamp_order,
+                   outputs_, camera_core_),
       FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get()},
       in_stamp_order, state_queue_, fusion_ready_, state_ready_, *heartbeats_[stage++],
       *fusion_counters_);
@@ -162,6 +187,10 @@ bool Pipeline::start(std::string& error) {
     // The device may appear later (USB enumeration, cable): the Source retries on read().
     POSED_LOG_WARN("IMU source not open yet: %s; retrying in the background", open_error.c_str());
   }
+  // OpenCV (the camera front end) would start a pool of worker threads of its own; the stages
+  // are the threads this pipeline runs (their priorities and CPUs are configured), so OpenCV
+  // runs sequentially on the fusion thread.
+  cv::setNumThreads(0);
   const HostTime now = drivers::host_now();
   for (auto& h : heartbeats_) h->reset(now);
   started_ = true;
@@ -191,6 +220,10 @@ void Pipeline::join() {
 
 void Pipeline::export_map(MapExport& out) const {
   if (fusion_stage_) fusion_stage_->core().export_map(out);
+}
+
+std::vector<CameraFigures> Pipeline::camera_compare_figures() const {
+  return camera_core_ ? camera_core_->cameras().compare_figures() : std::vector<CameraFigures>{};
 }
 
 std::string Pipeline::estimator_description() const {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/estimator/nav_state.hpp"
+#include "core/fusion/camera_front_end.hpp"
 #include "core/spsc_queue.hpp"
 #include "core/time.hpp"
 #include "daemon/config/posed_config.hpp"
@@ -27,6 +28,10 @@
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 #include "drivers/common/source.hpp"
+
+namespace posed::fusion {
+class CameraAidedCore;
+}
 
 namespace posed::pipeline {
 
@@ -55,6 +60,17 @@ struct PipelineSources {
   const drivers::Source* camera(CameraStream s) const {
     return s == CameraStream::kVisible ? visible.get() : thermal.get();
   }
+
+  /// Calls `f(std::unique_ptr<drivers::Source>&)` on every slot above, set or not, so code that
+  /// treats all Sources alike (the recording tap, `posectl record`) needs no list of its own:
+  /// a new Source field must be added here too.
+  template <class F>
+  void for_each(F&& f) {
+    f(imu);
+    f(lidar);
+    f(visible);
+    f(thermal);
+  }
 };
 
 /// Callbacks run on the publisher thread.
@@ -65,6 +81,11 @@ struct PipelineOutputs {
   std::function<void(const PipelineStatus&)> on_status;
   /// keep a whole-run map for export_map() (posed --save-map); costs memory as the area grows
   bool keep_map = false;
+  /// `posectl inspect frontend`: further camera front ends in these modes beside the
+  /// configured one, on the same frames, for comparison (camera_compare_figures())
+  std::vector<vision::FrontendMode> frontend_compare_modes;
+  /// sees every frame a camera front end processed, on the fusion thread; must outlive the run
+  fusion::FrontendObserver* frontend_observer = nullptr;
 };
 
 /// One stage's last sign of life, for the systemd watchdog.
@@ -100,6 +121,8 @@ class Pipeline {
   std::string estimator_description() const;
   /// The fusion core's map and keyframes (call after join(); empty without a lidar or keep_map).
   void export_map(MapExport& out) const;
+  /// The comparison front ends' figures (call after join(); empty without them).
+  std::vector<CameraFigures> camera_compare_figures() const;
 
  private:
   Heartbeat& add_stage(std::string name);
@@ -128,6 +151,8 @@ class Pipeline {
   std::unique_ptr<LidarStage> lidar_stage_;
   std::unique_ptr<CameraStage> camera_stages_[2];
   std::unique_ptr<FusionStage> fusion_stage_;
+  /// the fusion core when it has cameras (owned by fusion_stage_)
+  const fusion::CameraAidedCore* camera_core_ = nullptr;
   std::unique_ptr<PublisherStage> publisher_stage_;
   bool started_ = false;
   std::atomic<std::size_t> finished_stages_{0};

@@ -1,6 +1,24 @@
 #include "daemon/pipeline/recording_tap.hpp"
 
+#include <fstream>
+#include <sstream>
+
+#include "daemon/config/config_loader.hpp"
+
 namespace posed::pipeline {
+
+namespace {
+
+/// A file's contents for the recording's metadata ("" when unset or unreadable).
+std::string read_text_file(const std::string& path) {
+  if (path.empty()) return {};
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
 
 RecordingTap::RecordingTap(std::unique_ptr<drivers::Source> inner,
                            drivers::recording::Recorder& recorder,
@@ -22,6 +40,38 @@ drivers::ReadStatus RecordingTap::read(drivers::RawChunk& chunk, Duration timeou
     recorder_.record(channel_ids_[chunk.channel], chunk);
   }
   return rs;
+}
+
+std::map<std::string, std::string> recording_metadata(const config::PosedConfig& config,
+                                                      std::string_view stream) {
+  // Every channel carries the effective configuration: a recording says how it was made.
+  std::map<std::string, std::string> md{{"posed.config", config::print_config(config)}};
+  if (stream == "imu") {
+    md["posed.imu.source"] = config.imu.source;
+    md["posed.imu.device"] = config.imu.serial_device;
+  } else if (stream == "lidar") {
+    md["posed.lidar.address"] = config.lidar.address;
+    md["posed.lidar.calibration"] = config.lidar.calibration;
+    md["posed.lidar.calibration_text"] = read_text_file(config.lidar.calibration);
+  } else if (stream == "visible" || stream == "thermal") {
+    const config::CameraSection& camera =
+        stream == "visible" ? config.visible_camera : config.thermal_camera;
+    const std::string prefix = "posed." + std::string(stream) + ".";
+    md[prefix + "device"] = camera.device;
+    md[prefix + "source"] = camera.source;
+    md[prefix + "format"] = camera.format;
+  }
+  return md;
+}
+
+void tap_sources(PipelineSources& sources, drivers::recording::Recorder& recorder,
+                 const config::PosedConfig& config) {
+  sources.for_each([&](std::unique_ptr<drivers::Source>& source) {
+    if (!source) return;
+    const std::string stream(source->name());
+    source = std::make_unique<RecordingTap>(std::move(source), recorder,
+                                            recording_metadata(config, stream));
+  });
 }
 
 }  // namespace posed::pipeline

@@ -3,12 +3,18 @@
 // and hands a copy of the bytes to the Recorder, before any decoding, so a replay exercises
 // decoding, clock sync and fusion exactly as on the robot. Recording never blocks the Source:
 // the Recorder's queues drop (and count) when the disk falls behind.
+//
+// tap_sources() is the one place that decides what a recording's raw channels carry; `posed
+// --record` and `posectl record` both call it, so their files are the same and replay the same.
 
 #include <array>
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 
+#include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/pipeline.hpp"
 #include "drivers/common/source.hpp"
 #include "drivers/recording/recorder.hpp"
 
@@ -37,5 +43,17 @@ class RecordingTap final : public drivers::Source {
   drivers::recording::Recorder& recorder_;
   std::array<std::uint16_t, 2> channel_ids_;
 };
+
+/// The metadata a recording stores with every raw channel of `stream`: the effective
+/// configuration (`posed.config`, the text of `posed --print-config`) on every stream, plus what
+/// a reader of that stream needs to know about the device (IMU source and device path; lidar
+/// address, calibration path and the calibration file's text).
+std::map<std::string, std::string> recording_metadata(const config::PosedConfig& config,
+                                                      std::string_view stream);
+
+/// Wraps every Source in `sources` (whatever PipelineSources::for_each visits) in a RecordingTap
+/// with recording_metadata() for its stream name.
+void tap_sources(PipelineSources& sources, drivers::recording::Recorder& recorder,
+                 const config::PosedConfig& config);
 
 }  // namespace posed::pipeline

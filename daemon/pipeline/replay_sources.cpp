@@ -24,9 +24,10 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   }
   std::set<std::string> streams;
   for (const auto& [id, channel] : reader.channels()) {
-    if (channel.message_encoding != recording::raw::kMessageEncoding) continue;
+    if (!recording::raw::is_stream_channel(channel.message_encoding, channel.metadata)) continue;
     const auto it = channel.metadata.find(std::string(recording::raw::kStreamKey));
-    if (it != channel.metadata.end()) streams.insert(it->second);
+    if (it == channel.metadata.end()) continue;
+    streams.insert(it->second);
   }
   for (const auto& record : reader.metadata()) {
     if (record.name != recording::raw::kMetadataName) continue;
@@ -40,8 +41,12 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     }
   }
   if (!streams.count("imu")) {
-    error = options.path + ": no raw IMU stream (/posed/raw/imu) to replay; found: " +
-            (streams.empty() ? std::string("no raw streams") : *streams.begin());
+    std::string found;
+    for (const auto& s : streams) found += (found.empty() ? "" : ", ") + s;
+    error = options.path +
+            ": no IMU stream to replay (/posed/raw/imu, or an imported topic mapped to imu: "
+            "posectl import --topic-map TOPIC=imu); found: " +
+            (found.empty() ? std::string("no streams") : found);
     return out;
   }
 
@@ -58,15 +63,17 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
-  // Cameras replay when recorded; other streams (the D435i's depth, a second IMU) have no stage
-  // to go to: they are listed, said once, and never read.
-  if (streams.count("visible")) out.built.sources.visible = make("visible");
-  if (streams.count("thermal")) out.built.sources.thermal = make("thermal");
+  // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp).
+  // Other streams (the D435i's depth, a second IMU) have no stage: listed, said once in the log,
+  // never read.
+  const auto replay_camera = [&](const std::string& stream) { return streams.count(stream) != 0; };
+  if (replay_camera("visible")) out.built.sources.visible = make("visible");
+  if (replay_camera("thermal")) out.built.sources.thermal = make("thermal");
   std::string skipped;
   for (const auto& s : streams) {
-    out.streams += (out.streams.empty() ? "" : ", ") + s;
-    if (s != "imu" && s != "lidar" && s != "visible" && s != "thermal")
-      skipped += (skipped.empty() ? "" : ", ") + s;
+    const bool replayed = s == "imu" || s == "lidar" || s == "visible" || s == "thermal";
+    out.streams += (out.streams.empty() ? "" : ", ") + s + (replayed ? "" : " (not replayed)");
+    if (!replayed) skipped += (skipped.empty() ? "" : ", ") + s;
   }
   if (!skipped.empty()) {
     POSED_LOG_NOTICE("%s: no pipeline stage for stream(s) %s: not replayed", options.path.c_str(),

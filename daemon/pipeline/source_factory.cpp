@@ -4,6 +4,7 @@
 
 #include "daemon/pipeline/camera_stage.hpp"
 #include "drivers/camera/aravis_source.hpp"
+#include "drivers/camera/d4xx_video_source.hpp"
 #include "drivers/camera/v4l2_source.hpp"
 #include "drivers/imu/serial_source.hpp"
 #include "drivers/recording/pcap_source.hpp"
@@ -68,6 +69,15 @@ bool make_camera_source(const config::PosedConfig& config, CameraStream stream,
   v.width = static_cast<std::uint32_t>(section.width);
   v.height = static_cast<std::uint32_t>(section.height);
   v.fps = static_cast<std::uint32_t>(std::lround(section.rate_hz));
+  if (stream == CameraStream::kVisible) {
+    // The D435i: the colour node with its uvcvideo metadata node, whose hardware timestamps
+    // the camera stage's clock prefers (frames still flow when the metadata node is missing).
+    drivers::camera::D4xxVideoConfig d4xx;
+    d4xx.video = std::move(v);
+    sources.camera(stream) = std::make_unique<drivers::camera::D4xxVideoSource>(
+        name, drivers::camera::system_v4l2_device(), std::move(d4xx));
+    return true;
+  }
   sources.camera(stream) = std::make_unique<drivers::camera::V4l2Source>(
       name, drivers::camera::system_v4l2_device(), std::move(v));
   return true;

@@ -175,7 +175,9 @@ bool V4l2Capture::negotiate(std::string& error) {
   } else {
     negotiated_.fourcc = fmt.fmt.meta.dataformat;
     negotiated_.frame_bytes = fmt.fmt.meta.buffersize;
-    if (negotiated_.fourcc != config_.meta_fourcc) {
+    const auto& alt = config_.meta_fourcc_alternatives;
+    if (negotiated_.fourcc != config_.meta_fourcc &&
+        std::find(alt.begin(), alt.end(), negotiated_.fourcc) == alt.end()) {
       error = "camera " + path_ + ": metadata format " + fourcc_to_string(config_.meta_fourcc) +
               " not offered (driver has " + fourcc_to_string(negotiated_.fourcc) + ")";
       return false;

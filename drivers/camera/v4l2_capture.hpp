@@ -36,6 +36,9 @@ struct V4l2CaptureConfig {
   WireFormat format = WireFormat::kYuyv;
   /// metadata nodes: the fourcc (V4L2_META_FMT_UVC 'UVCH', or 'D4XX' on patched kernels)
   std::uint32_t meta_fourcc = fourcc('U', 'V', 'C', 'H');
+  /// metadata nodes: further fourccs accepted when the driver offers one of them instead of
+  /// meta_fourcc (the same uvc_meta_buf layout under another name: 'UVCH' vs 'D4XX')
+  std::vector<std::uint32_t> meta_fourcc_alternatives;
   std::uint32_t width = 640;   ///< [px]
   std::uint32_t height = 480;  ///< [px]
   std::uint32_t fps = 30;      ///< requested frame rate [Hz]; 0 leaves the driver's choice

@@ -1,8 +1,9 @@
 #pragma once
 // CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, init and final XOR 0xFFFFFFFF): the
 // checksum MCAP uses for chunks, the data section and the summary (mcap.dev spec, "Chunk",
-// "Data End", "Footer"); identical to zlib's crc32(). Slicing-by-8 so that checking a chunk costs
-// far less than decompressing it.
+// "Data End", "Footer"); identical to zlib's crc32(). Carry-less multiplication (PCLMULQDQ) on
+// x86-64 CPUs that have it, slicing-by-8 tables elsewhere and for the last bytes, so that
+// checking a chunk costs far less than decompressing it.
 
 #include <cstddef>
 #include <cstdint>

@@ -139,6 +139,13 @@ void McapReader::issue(std::uint64_t offset, std::string what) {
   if (issues_.size() < 100) issues_.push_back({offset, std::move(what)});
 }
 
+void McapReader::unknown(std::uint64_t offset, std::int64_t chunk_byte, std::uint8_t opcode,
+                         std::uint64_t length) {
+  ++counters_.unknown_records;
+  if (unknown_records_.size() < 100)
+    unknown_records_.push_back({offset, chunk_byte, opcode, length});
+}
+
 void McapReader::stop(std::uint64_t offset, std::string what) {
   stop_reason_ = fmt("%s at offset %llu; read up to offset %llu of %llu B", what.c_str(),
                      ull(offset), ull(offset), ull(file_.size()));
@@ -152,6 +159,7 @@ bool McapReader::open_common(std::string& error) {
   schemas_.clear();
   metadata_.clear();
   issues_.clear();
+  unknown_records_.clear();
   summary_ = {};
   counters_ = {};
   if (file_.size() < mcap::kMagicSize ||
@@ -175,7 +183,9 @@ bool McapReader::open_common(std::string& error) {
     return false;
   }
   data_start_ = mcap::kMagicSize + in.pos();
+  summary_channels_.reset();
   read_summary();
+  for (const auto& [id, c] : channels_) summary_channels_.set(id);
   rewind();
   return true;
 }
@@ -321,6 +331,7 @@ bool McapReader::parse_channel(std::span<const std::byte> body, std::uint64_t of
     issue(offset, fmt("Channel %u (%s) refers to schema %u, which is not defined before it", c.id,
                       c.topic.c_str(), c.schema_id));
   }
+  seen_channels_.set(c.id);
   if (const auto it = channels_.find(c.id); it != channels_.end()) {
     // Repeats (summary copy, next chunk) must be identical (spec); keep the first one so the
     // pointers handed out in McapMessage stay valid.
@@ -339,6 +350,7 @@ void McapReader::rewind() {
   crc_pos_ = 0;
   chunk_records_ = {};
   chunk_pos_ = 0;
+  seen_channels_.reset();
 }
 
 bool McapReader::decode_message(std::span<const std::byte> body, std::uint64_t offset,
@@ -354,7 +366,7 @@ bool McapReader::decode_message(std::span<const std::byte> body, std::uint64_t o
     return false;
   }
   const auto it = channels_.find(channel_id);
-  if (it == channels_.end()) {
+  if (it == channels_.end() || !(summary_channels_[channel_id] || seen_channels_[channel_id])) {
     ++counters_.orphan_messages;
     if (counters_.orphan_messages <= 10) {
       issue(offset, fmt("Message on channel %u, which has no Channel record", channel_id));
@@ -381,6 +393,7 @@ bool McapReader::next_in_chunk(McapMessage& out) {
       chunk_pos_ = chunk_records_.size();
       break;
     }
+    const std::size_t record_at = chunk_pos_;
     chunk_pos_ += mcap::kRecordPrefixSize + static_cast<std::size_t>(len);
     switch (static_cast<Op>(op)) {
       case Op::kSchema:
@@ -393,8 +406,9 @@ bool McapReader::next_in_chunk(McapMessage& out) {
         if (decode_message(body, chunk_offset_, out)) return true;
         break;
       default:
-        ++counters_.unknown_records;
-        break;  // only Schema/Channel/Message belong in chunks; anything else is skipped
+        // Only Schema/Channel/Message belong in chunks; anything else is skipped.
+        unknown(chunk_offset_, static_cast<std::int64_t>(record_at), op, len);
+        break;
     }
   }
   chunk_records_ = {};
@@ -581,7 +595,7 @@ bool McapReader::next(McapMessage& out) {
       case Op::kSummaryOffset:
         break;  // index records: a linear reader does not need them
       default:
-        ++counters_.unknown_records;  // unknown opcode: skipped, as the spec says
+        unknown(at, -1, op, len);  // unknown opcode: skipped, as the spec says
         break;
     }
   }

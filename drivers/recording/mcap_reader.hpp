@@ -10,6 +10,7 @@
 // on wherever the format allows (unknown opcodes are skipped as the spec says; a chunk with a bad
 // CRC or an unknown compression is skipped) and stops at the first record cut short.
 
+#include <bitset>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -53,6 +54,16 @@ struct McapMessage {
 struct McapIssue {
   std::uint64_t offset = 0;  ///< file offset of the offending record [B]
   std::string what;          ///< "truncated Chunk record: needs 1048600 B, 5120 B left"
+};
+
+/// A record whose opcode this reader does not know (or that does not belong where it was found),
+/// skipped as the spec says: application extensions (0x80-0xFF), opcodes of a newer spec.
+struct McapUnknownRecord {
+  std::uint64_t offset = 0;  ///< file offset of the record, or of the Chunk holding it [B]
+  /// position in the Chunk's uncompressed records; -1 for a record of the data section [B]
+  std::int64_t chunk_byte = -1;
+  std::uint8_t opcode = 0;
+  std::uint64_t length = 0;  ///< content length [B]
 };
 
 struct McapMetadataRecord {
@@ -129,6 +140,8 @@ class McapReader {
   const std::map<std::uint16_t, McapSchemaRecord>& schemas() const { return schemas_; }
   const McapSchemaRecord* schema(std::uint16_t id) const;
   const std::vector<McapIssue>& issues() const { return issues_; }
+  /// the first 100 records skipped for their opcode (counters().unknown_records counts all)
+  const std::vector<McapUnknownRecord>& unknown_records() const { return unknown_records_; }
   const McapSummaryInfo& summary() const { return summary_; }
   const std::vector<McapMetadataRecord>& metadata() const { return metadata_; }
   const McapReaderCounters& counters() const { return counters_; }
@@ -141,6 +154,8 @@ class McapReader {
   bool parse_schema(std::span<const std::byte> body, std::uint64_t offset);
   bool parse_channel(std::span<const std::byte> body, std::uint64_t offset);
   void issue(std::uint64_t offset, std::string what);
+  void unknown(std::uint64_t offset, std::int64_t chunk_byte, std::uint8_t opcode,
+               std::uint64_t length);
   void stop(std::uint64_t offset, std::string what);
   bool enter_chunk(std::span<const std::byte> body, std::uint64_t offset);
   bool next_in_chunk(McapMessage& out);
@@ -171,8 +186,14 @@ class McapReader {
 
   std::map<std::uint16_t, McapChannelRecord> channels_;
   std::map<std::uint16_t, McapSchemaRecord> schemas_;
+  // Which channels a message may use: those of a usable summary, and those whose Channel record
+  // this pass has read. Records learnt in an earlier pass stay in channels_ (McapMessage points
+  // into it) but do not count, so every pass over a damaged file reads the same messages.
+  std::bitset<65536> summary_channels_;
+  std::bitset<65536> seen_channels_;
   std::vector<McapMetadataRecord> metadata_;
   std::vector<McapIssue> issues_;
+  std::vector<McapUnknownRecord> unknown_records_;
   McapSummaryInfo summary_;
   McapReaderCounters counters_;
 };

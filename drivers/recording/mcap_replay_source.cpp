@@ -21,7 +21,8 @@ McapReplaySource::McapReplaySource(McapReplayConfig config)
     : config_(std::move(config)), name_(config_.name.empty() ? config_.stream : config_.name) {}
 
 bool McapReplaySource::wanted(const McapChannelRecord& c) const {
-  return c.message_encoding == raw::kMessageEncoding && meta(c, raw::kStreamKey) == config_.stream;
+  return raw::is_stream_channel(c.message_encoding, c.metadata) &&
+         meta(c, raw::kStreamKey) == config_.stream;
 }
 
 bool McapReplaySource::open(std::string& error) {
@@ -31,7 +32,9 @@ bool McapReplaySource::open(std::string& error) {
     std::set<std::string> streams;
     bool found = false;
     for (const auto& [id, c] : reader_.channels()) {
-      if (c.message_encoding == raw::kMessageEncoding) streams.insert(meta(c, raw::kStreamKey));
+      if (raw::is_stream_channel(c.message_encoding, c.metadata)) {
+        streams.insert(meta(c, raw::kStreamKey));
+      }
       if (wanted(c)) {
         found = true;
         std::lock_guard lock(info_mutex_);

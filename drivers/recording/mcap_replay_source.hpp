@@ -1,6 +1,8 @@
 #pragma once
 // Replays one stream of an MCAP recording through the Source interface (DESIGN.md, Data flow):
-// every raw channel whose posed.stream matches (raw_channels.hpp), merged in file order, each
+// every raw channel whose posed.stream matches (raw_channels.hpp; imported ROS 1 channels mapped
+// onto the stream count as raw channels whose wire format is "ros1:<type>"), merged in file
+// order, each
 // read() returning the recorded bytes with the recorded log time as host_receive and the
 // recorded posed.source_channel as RawChunk::channel. Decoders, ClockSync and fusion downstream
 // cannot tell it from the device, and, being not live, the pipeline never drops its data:

@@ -14,9 +14,15 @@
 //
 // Poses and ground truth are ROS 2 CDR messages on their own topics (ros2_messages.hpp), and a
 // Metadata record named "posed" holds the host-to-wall clock offset of the recording.
+//
+// Imported ROS 1 bags (posectl import, docs/import.md) keep every connection as a channel on its
+// own topic with message_encoding ros1 and a ros1msg schema; a channel whose topic maps onto a
+// posed stream also carries posed.stream, posed.source_channel and posed.wire_format
+// ("ros1:<type>", drivers/common/wire_format.hpp), and replays like a raw channel.
 
 #include <charconv>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 
@@ -36,6 +42,20 @@ inline constexpr std::string_view kWireA9Serial = wire::kA9Serial;
 inline constexpr std::string_view kWireVelodyneData = wire::kVelodyneData;
 inline constexpr std::string_view kWireVelodynePosition = wire::kVelodynePosition;
 inline constexpr std::string_view kWireCanFrame = wire::kCanFrame;
+
+/// Imported ROS 1 messages (mcap.dev registry: message encoding "ros1", schema encoding
+/// "ros1msg" holding the connection's message_definition).
+inline constexpr std::string_view kRos1MessageEncoding = "ros1";
+inline constexpr std::string_view kRos1SchemaEncoding = "ros1msg";
+
+/// Whether a channel feeds a posed stream: raw Source bytes, or imported ROS 1 messages whose
+/// topic was mapped onto a stream.
+inline bool is_stream_channel(std::string_view message_encoding,
+                              const std::map<std::string, std::string>& metadata) {
+  if (message_encoding == kMessageEncoding) return true;
+  return message_encoding == kRos1MessageEncoding &&
+         metadata.find(std::string(kStreamKey)) != metadata.end();
+}
 
 /// The Metadata record with the recording's clock facts.
 inline constexpr std::string_view kMetadataName = "posed";

@@ -189,8 +189,13 @@ void Recorder::run() {
   for (;;) {
     // Read the flag before draining: whatever was queued before stop is drained below.
     const bool stopping = !running_.load(std::memory_order_acquire);
-    if (writer_.is_open()) register_channels();
-    const std::size_t n = channel_count_.load(std::memory_order_acquire);
+    // Drain only channels whose record is in the file: one added since register_channels() read
+    // the count waits for the next pass, so no message precedes its channel record.
+    std::size_t n = channel_count_.load(std::memory_order_acquire);
+    if (writer_.is_open()) {
+      register_channels();
+      n = registered_in_file_;
+    }
     batch.clear();
     for (std::size_t i = 0; i < n; ++i) {
       Item item;

@@ -28,6 +28,8 @@ std::span<const Benchmark> benchmarks() {
       Benchmark{"lio",
                 "Lidar-inertial estimator per scan on one core, by step (simulated VLP-32C + A9)",
                 bench_lio},
+      Benchmark{"frontend", "Visual-thermal front end per frame pair on one core, by step",
+                bench_frontend},
       Benchmark{"recording", "MCAP write (lz4, one core) and read throughput on /dev/shm",
                 bench_recording},
   };

@@ -35,5 +35,6 @@ int bench_camera();
 int bench_recording();
 int bench_sim();
 int bench_lio();
+int bench_frontend();
 
 }  // namespace posed::posectl

@@ -1,7 +1,8 @@
 // posectl bench camera: per-frame cost on one core of the camera decoders the daemon runs for
 // every frame: D435i YUYV 640x480 -> BGR (target <= 1 ms), Z16 640x480 -> depth image in a pool
 // buffer (<= 0.5 ms), PLUG 617 Y16 640x512 AGC (<= 1 ms; the real 16-bit thermal frame when the
-// shared data is found, else a synthetic one), MJPEG 640x512 decode (reported).
+// shared data is found, else a synthetic one), MJPEG 640x512 decode (reported); and the D435i's
+// small per-sample parsers: UVC frame metadata (per frame) and IIO IMU records (per sample).
 
 #include <algorithm>
 #include <chrono>
@@ -13,8 +14,10 @@
 
 #include "core/measurements.hpp"
 #include "core/payload_pool.hpp"
+#include "drivers/camera/d4xx_metadata.hpp"
 #include "drivers/camera/mjpeg_decoder.hpp"
 #include "drivers/camera/pixel_formats.hpp"
+#include "drivers/camera/realsense_imu_decoder.hpp"
 #include "drivers/camera/thermal_agc.hpp"
 #include "tools/posectl/bench.hpp"
 
@@ -41,6 +44,44 @@ void time_per_frame(std::string_view what, Fn&& fn, double min_s = 0.5) {
   const std::string base(what);
   report("camera", base + "_mean", sum / static_cast<double>(ms.size()), "ms/frame");
   report("camera", base + "_p99", ms[ms.size() * 99 / 100], "ms/frame");
+}
+
+/// Runs `fn` (which handles `items` items) repeatedly for `min_s`; reports the mean per item.
+template <class Fn>
+void time_per_item(std::string_view what, std::size_t items, Fn&& fn, double min_s = 0.3) {
+  std::size_t calls = 0;
+  const auto start = Clock::now();
+  double elapsed = 0;
+  while (calls < 10 || elapsed < min_s) {
+    fn();
+    ++calls;
+    elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  }
+  report("camera", std::string(what) + "_mean", elapsed * 1e9 / static_cast<double>(calls * items),
+         "ns/item");
+}
+
+/// A D435i depth frame's metadata buffer: uvc_meta_buf, UVC header with PTS and SCR, then
+/// md_capture_timing, md_capture_stats, md_depth_control, md_configuration.
+std::vector<std::byte> depth_metadata_buffer() {
+  std::vector<std::byte> b;
+  auto u8 = [&](std::uint32_t v) { b.push_back(static_cast<std::byte>(v & 0xFF)); };
+  auto u16 = [&](std::uint32_t v) { u8(v), u8(v >> 8); };
+  auto u32 = [&](std::uint32_t v) { u16(v & 0xFFFF), u16(v >> 16); };
+  u32(1'000'000), u32(0), u16(12);  // ns, sof
+  const std::size_t len_at = b.size();
+  u8(0), u8(0x8F);
+  u32(123456), u32(654321), u16(77);  // PTS, SCR
+  u32(cam::kMdCaptureTimingId), u32(32);
+  for (std::uint32_t v : {1u, 0x3Fu, 42u, 123456u, 15000u, 8000u, 33333u, 900u}) u32(v);
+  u32(0x00000003), u32(72);
+  for (int i = 0; i < 18; ++i) u32(0);
+  u32(cam::kMdDepthControlId), u32(52);
+  for (int i = 0; i < 13; ++i) u32(static_cast<std::uint32_t>(i));
+  u32(cam::kMdConfigurationId), u32(32);
+  for (int i = 0; i < 8; ++i) u32(static_cast<std::uint32_t>(i));
+  b[len_at] = static_cast<std::byte>(b.size() - cam::kUvcMetaBufPrefixBytes);
+  return b;
 }
 
 std::vector<std::uint16_t> thermal_frame(bool& real) {
@@ -128,6 +169,33 @@ int bench_camera() {
       std::fprintf(stderr, "posectl bench camera: MJPEG decode errors\n");
       return 1;
     }
+  }
+  {  // D435i UVC metadata, one buffer per frame
+    const auto md = depth_metadata_buffer();
+    cam::D4xxFrameMetadata out;
+    std::uint64_t sink = 0;
+    time_per_item("d4xx_metadata_parse", 1000, [&] {
+      for (int i = 0; i < 1000; ++i) {
+        cam::parse_d4xx_metadata(md, out);
+        sink += out.frame_counter;
+      }
+    });
+    if (sink == 0) return 1;
+  }
+  {  // D435i IIO records (24 B: x, y, z as le:s16/32, timestamp le:s64/64), a kernel buffer's
+     // worth per read
+    const char* wire =
+        "iio-hid-gyro-3d;in_anglvel_x:le:s16/32>>0;in_anglvel_y:le:s16/32>>0;"
+        "in_anglvel_z:le:s16/32>>0;in_timestamp:le:s64/64>>0";
+    cam::RealsenseImuDecoder dec(wire);
+    if (!dec.valid()) {
+      std::fprintf(stderr, "posectl bench camera: %s\n", dec.error().c_str());
+      return 1;
+    }
+    std::vector<std::byte> records(128 * 24);
+    for (std::size_t i = 0; i < records.size(); ++i) records[i] = static_cast<std::byte>(i * 13);
+    std::vector<cam::D4xxMotionSample> samples(128);
+    time_per_item("iio_imu_decode", 128, [&] { dec.decode(records, samples); });
   }
   return 0;
 }

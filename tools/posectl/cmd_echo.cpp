@@ -228,6 +228,17 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
       static_cast<unsigned long long>(e.reinitialisations), e.degenerate_directions,
       e.gyro_bias_radps.x(), e.gyro_bias_radps.y(), e.gyro_bias_radps.z(), e.accel_bias_mps2.x(),
       e.accel_bias_mps2.y(), e.accel_bias_mps2.z());
+  if (!m.camera.mode.empty()) {
+    const dds::CameraStatusMessage& c = m.camera;
+    std::printf(
+        "  cameras    %s front end: %llu frames (%llu unusable)  last frame %d features, %d with "
+        "lidar depth  match success %.1f %%  confidence visible %.2f thermal %.2f fused %.2f  "
+        "omega %.1f %.1f %.1f\n",
+        c.mode.c_str(), static_cast<unsigned long long>(c.frames),
+        static_cast<unsigned long long>(c.frames_unusable), c.features, c.depth_associated,
+        100.0 * c.match_success_rate, c.confidence[0], c.confidence[1], c.confidence[2], c.omega[0],
+        c.omega[1], c.omega[2]);
+  }
   for (const auto& s : m.streams) {
     std::printf(
         "  %-10s %8.2f Hz  received %llu decoded %llu dropped %llu malformed %llu  clock %s: "

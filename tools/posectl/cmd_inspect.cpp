@@ -127,11 +127,17 @@ constexpr std::array kKinds = {
     InspectKind{"a9", "Handsfree A9 IMU raw serial bytes", inspect_a9},
     InspectKind{"velodyne", "Velodyne VLP-32C/VLP-16/HDL-32E pcap or pcapng", run_inspect_velodyne},
     InspectKind{"mcap", "MCAP recording: channels, counts, rates, gaps, errors", run_inspect_mcap},
+    InspectKind{"frontend",
+                "camera front end on a recording: visible, thermal and fused side by side",
+                run_inspect_frontend},
+    InspectKind{"camera", "cameras: --list (V4L2, GenICam), or capture N frames to PNG",
+                run_inspect_camera},
 };
 
 void print_usage(std::FILE* out) {
   std::fprintf(out,
                "usage: posectl inspect KIND FILE [options]\n"
+               "       posectl inspect FILE.mcap [options]   (same as: posectl inspect mcap FILE)\n"
                "       posectl inspect KIND --help\n\n"
                "Decodes a raw capture and prints one line per frame/packet, then a summary.\n\n"
                "kinds:\n");
@@ -155,6 +161,10 @@ int run_inspect(int argc, char** argv) {
   }
   for (const auto& k : kKinds) {
     if (k.name == kind) return k.run(argc - 1, argv + 1);
+  }
+  // `posectl inspect FILE.mcap`: a recording needs no kind; argv[1] is then its FILE.
+  if (kind.size() > 5 && kind.substr(kind.size() - 5) == ".mcap") {
+    return run_inspect_mcap(argc, argv);
   }
   std::fprintf(stderr, "posectl inspect: unknown kind '%s'\n\n", argv[1]);
   print_usage(stderr);

@@ -7,7 +7,8 @@ namespace posed::posectl {
 std::span<const Command> commands() {
   static const std::array kCommands = {
       Command{"bench", "run benchmarks; prints `NAME METRIC VALUE UNIT` lines", run_bench},
-      Command{"inspect", "decode a raw sensor capture: one line per frame, then a summary",
+      Command{"inspect",
+              "decode a raw sensor capture frame by frame, or list a recording (FILE.mcap)",
               run_inspect},
       Command{"echo", "print posed's DDS topics (odom, pose, status) with rate and latency",
               run_echo},
@@ -17,6 +18,13 @@ std::span<const Command> commands() {
               "simulate the rig in a scenario: a recording with raw sensor data and ground truth",
               run_sim},
       Command{"export", "write an MCAP recording's poses (TUM) or its lidar map (PCD)", run_export},
+      Command{"replay",
+              "re-emit a recording onto UDP and a pty with its timing (hardware-in-the-loop)",
+              run_replay},
+      Command{"record", "record the raw bytes of the config's live Sources to MCAP (no fusion)",
+              run_record},
+      Command{"import", "turn a pcap capture, candump log or ROS 1 bag into a posed recording",
+              run_import},
   };
   return kCommands;
 }

@@ -18,10 +18,15 @@ std::span<const Command> commands();
 int run_bench(int argc, char** argv);
 int run_inspect(int argc, char** argv);
 int run_inspect_velodyne(int argc, char** argv);
+int run_inspect_camera(int argc, char** argv);
 int run_echo(int argc, char** argv);
 int run_eval(int argc, char** argv);
 int run_sim(int argc, char** argv);
 int run_inspect_mcap(int argc, char** argv);
+int run_inspect_frontend(int argc, char** argv);
 int run_export(int argc, char** argv);
+int run_record(int argc, char** argv);
+int run_replay(int argc, char** argv);
+int run_import(int argc, char** argv);
 
 }  // namespace posed::posectl

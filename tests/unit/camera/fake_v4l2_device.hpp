@@ -10,9 +10,12 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <deque>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -56,6 +59,10 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
   std::uint32_t max_buffers = 8;           ///< REQBUFS grants at most this many
   int failing_opens_after_disconnect = 0;  ///< open() attempts that fail (ENOENT) after unplug
   std::deque<FakeEvent> script;
+  /// the descriptor open() returns; distinct per node when several share a FakeV4l2Bus
+  int fd_number = 42;
+  /// VIDIOC_ENUM_FRAMEINTERVALS answers (discrete, 1/fps) for every mode
+  std::vector<std::uint32_t> frame_rates{30, 15};
 
   // --- observations ---
   std::vector<std::string> calls;  ///< ioctl names in order
@@ -82,10 +89,10 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
       return -1;
     }
     ++open_fds;
-    return kFd;
+    return fd_number;
   }
   int close(int fd) override {
-    if (fd != kFd) return set_errno(EBADF);
+    if (fd != fd_number) return set_errno(EBADF);
     ++closes;
     --open_fds;
     streaming = false;
@@ -94,7 +101,7 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
   }
 
   void* mmap(std::size_t length, int prot, int flags, int fd, off_t offset) override {
-    if (fd != kFd || memfd_ < 0) {
+    if (fd != fd_number || memfd_ < 0) {
       errno = EINVAL;
       return MAP_FAILED;
     }
@@ -136,7 +143,7 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
   }
 
   int ioctl(int fd, unsigned long request, void* arg) override {
-    if (fd != kFd) return set_errno(EBADF);
+    if (fd != fd_number) return set_errno(EBADF);
     if (disconnected_) {
       calls.push_back("ENODEV");
       return set_errno(ENODEV);
@@ -251,6 +258,53 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
         b->timestamp.tv_usec = e.stamp_us % 1'000'000;
         return 0;
       }
+      case VIDIOC_ENUM_FMT: {
+        calls.push_back("ENUM_FMT");
+        auto* f = static_cast<v4l2_fmtdesc*>(arg);
+        std::vector<std::uint32_t> fourccs;
+        if (f->type == V4L2_BUF_TYPE_META_CAPTURE) {
+          fourccs.assign(meta_formats.begin(), meta_formats.end());
+        } else {
+          for (const auto& m : modes) {
+            if (std::find(fourccs.begin(), fourccs.end(), m.fourcc) == fourccs.end()) {
+              fourccs.push_back(m.fourcc);
+            }
+          }
+        }
+        if (f->index >= fourccs.size()) return set_errno(EINVAL);
+        f->pixelformat = fourccs[f->index];
+        std::snprintf(reinterpret_cast<char*>(f->description), sizeof f->description, "fake %u",
+                      f->index);
+        return 0;
+      }
+      case VIDIOC_ENUM_FRAMESIZES: {
+        calls.push_back("ENUM_FRAMESIZES");
+        auto* f = static_cast<v4l2_frmsizeenum*>(arg);
+        std::uint32_t k = 0;
+        for (const auto& m : modes) {
+          if (m.fourcc != f->pixel_format) continue;
+          if (k++ == f->index) {
+            f->type = V4L2_FRMSIZE_TYPE_DISCRETE;
+            f->discrete.width = m.width;
+            f->discrete.height = m.height;
+            return 0;
+          }
+        }
+        return set_errno(EINVAL);
+      }
+      case VIDIOC_ENUM_FRAMEINTERVALS: {
+        calls.push_back("ENUM_FRAMEINTERVALS");
+        auto* f = static_cast<v4l2_frmivalenum*>(arg);
+        bool known = false;
+        for (const auto& m : modes) {
+          known |= m.fourcc == f->pixel_format && m.width == f->width && m.height == f->height;
+        }
+        if (!known || f->index >= frame_rates.size()) return set_errno(EINVAL);
+        f->type = V4L2_FRMIVAL_TYPE_DISCRETE;
+        f->discrete.numerator = 1;
+        f->discrete.denominator = frame_rates[f->index];
+        return 0;
+      }
       case VIDIOC_STREAMON:
         calls.push_back("STREAMON");
         streaming = true;
@@ -289,7 +343,6 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
   bool disconnected() const { return disconnected_; }
 
  private:
-  static constexpr int kFd = 42;
   static int set_errno(int e) {
     errno = e;
     return -1;
@@ -303,6 +356,69 @@ class FakeV4l2Device final : public drivers::camera::V4l2Device {
   std::uint32_t buffer_count_ = 0;
   std::uint32_t frame_bytes_ = 0;
   std::size_t stride_ = 0;
+};
+
+/// Several fake nodes behind one V4l2Device, routed by path (open) and descriptor (the rest),
+/// like the video and metadata nodes of one UVC camera: each attached node gets its own fd.
+class FakeV4l2Bus final : public drivers::camera::V4l2Device {
+ public:
+  int waits = 0;  ///< poll() calls without descriptors (reopen back-off)
+
+  void attach(const std::string& path, FakeV4l2Device& node) {
+    node.present_paths = {path};
+    node.fd_number = next_fd_++;
+    by_path_[path] = &node;
+    by_fd_[node.fd_number] = &node;
+  }
+  int open(const char* path, int flags) override {
+    const auto it = by_path_.find(path);
+    if (it == by_path_.end()) {
+      errno = ENOENT;
+      return -1;
+    }
+    return it->second->open(path, flags);
+  }
+  int close(int fd) override { return node(fd) ? node(fd)->close(fd) : bad(); }
+  int ioctl(int fd, unsigned long request, void* arg) override {
+    return node(fd) ? node(fd)->ioctl(fd, request, arg) : bad();
+  }
+  void* mmap(std::size_t length, int prot, int flags, int fd, off_t offset) override {
+    if (node(fd) == nullptr) {
+      errno = EBADF;
+      return MAP_FAILED;
+    }
+    void* p = node(fd)->mmap(length, prot, flags, fd, offset);
+    if (p != MAP_FAILED) mapped_by_[p] = node(fd);
+    return p;
+  }
+  int munmap(void* addr, std::size_t length) override {
+    const auto it = mapped_by_.find(addr);
+    if (it == mapped_by_.end()) return ::munmap(addr, length);
+    FakeV4l2Device* n = it->second;
+    mapped_by_.erase(it);
+    return n->munmap(addr, length);
+  }
+  int poll(pollfd* fds, nfds_t nfds, int timeout_ms) override {
+    if (nfds == 0) {
+      ++waits;
+      return 0;
+    }
+    return node(fds[0].fd) ? node(fds[0].fd)->poll(fds, nfds, timeout_ms) : bad();
+  }
+
+ private:
+  FakeV4l2Device* node(int fd) {
+    const auto it = by_fd_.find(fd);
+    return it == by_fd_.end() ? nullptr : it->second;
+  }
+  static int bad() {
+    errno = EBADF;
+    return -1;
+  }
+  int next_fd_ = 100;
+  std::map<std::string, FakeV4l2Device*> by_path_;
+  std::map<int, FakeV4l2Device*> by_fd_;
+  std::map<void*, FakeV4l2Device*> mapped_by_;
 };
 
 }  // namespace posed::test

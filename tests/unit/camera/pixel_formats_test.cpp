@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -156,6 +157,41 @@ TEST(Mjpeg, DecodesWhatTurboJpegEncodedAndReportsCorruption) {
 
   std::vector<std::byte> grey(w * h);
   ASSERT_EQ(dec.decode(jpeg, w, h, {grey, 0}, PixelFormat::kMono8), ConvertStatus::kOk);
+}
+
+}  // namespace
+}  // namespace posed::drivers::camera
+
+namespace posed::drivers::camera {
+namespace {
+
+// The table-driven kernel against the BT.601 fixed-point formula it tabulates (OpenCV's
+// ITUR_BT_601 coefficients, 20-bit), for every Y, U and V.
+TEST(PixelFormats, YuyvKernelMatchesTheFixedPointFormulaForAllSamples) {
+  constexpr int kShift = 20, kCY = 1220542, kCVR = 1673527, kCVG = -852492, kCUG = -409993,
+                kCUB = 2116026, kRound = 1 << 19;
+  auto clamp = [](int x) { return x < 0 ? 0 : x > 255 ? 255 : x; };
+  std::vector<std::uint8_t> row(512), out(768);
+  int mismatches = 0;
+  for (int u = 0; u < 256; ++u) {
+    for (int v = 0; v < 256; ++v) {
+      for (int k = 0; k < 128; ++k) {  // pairs (Y0, Y1) = (2k, 2k + 1): every Y once
+        row[4 * k] = static_cast<std::uint8_t>(2 * k);
+        row[4 * k + 1] = static_cast<std::uint8_t>(u);
+        row[4 * k + 2] = static_cast<std::uint8_t>(2 * k + 1);
+        row[4 * k + 3] = static_cast<std::uint8_t>(v);
+      }
+      yuv422_to_bgr(row.data(), 512, out.data(), 768, 256, 1, false);
+      for (int y = 0; y < 256; ++y) {
+        const int yy = std::max(0, y - 16) * kCY;
+        const int b = clamp((yy + kRound + kCUB * (u - 128)) >> kShift);
+        const int g = clamp((yy + kRound + kCVG * (v - 128) + kCUG * (u - 128)) >> kShift);
+        const int r = clamp((yy + kRound + kCVR * (v - 128)) >> kShift);
+        mismatches += out[3 * y] != b || out[3 * y + 1] != g || out[3 * y + 2] != r;
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "drivers/camera/v4l2_enumerate.hpp"
 #include "tests/unit/camera/fake_v4l2_device.hpp"
 
 namespace posed::drivers::camera {
@@ -306,6 +307,59 @@ TEST(V4l2Capture, SerialResolvesThroughByIdLinks) {
   fs::remove_all(dir);
   EXPECT_EQ(resolve_v4l2_device("serial:1", dir.string(), error), "");
   EXPECT_NE(error.find("cannot list"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace posed::drivers::camera
+
+namespace posed::drivers::camera {
+namespace {
+
+TEST(V4l2Enumerate, FormatsSizesAndRatesOfANode) {
+  test::FakeV4l2Device dev;
+  dev.modes = {{fourcc('Y', 'U', 'Y', 'V'), 640, 480, 2},
+               {fourcc('Y', 'U', 'Y', 'V'), 1280, 720, 2},
+               {fourcc('Z', '1', '6', ' '), 848, 480, 2}};
+  dev.frame_rates = {60, 30, 15};
+  V4l2NodeInfo info;
+  std::string error;
+  ASSERT_TRUE(query_v4l2_node(dev, "/dev/video0", info, error)) << error;
+  EXPECT_EQ(info.card, "Fake Camera");
+  EXPECT_EQ(info.driver, "uvcvideo");
+  EXPECT_TRUE(info.video_capture);
+  ASSERT_EQ(info.formats.size(), 2u);
+  EXPECT_EQ(info.formats[0].fourcc, fourcc('Y', 'U', 'Y', 'V'));
+  ASSERT_EQ(info.formats[0].sizes.size(), 2u);
+  EXPECT_EQ(info.formats[0].sizes[1].width, 1280u);
+  EXPECT_EQ(info.formats[0].sizes[1].rates_hz, (std::vector<double>{60, 30, 15}));
+  EXPECT_EQ(info.formats[1].sizes[0].height, 480u);
+  EXPECT_EQ(dev.open_fds, 0);
+
+  test::FakeV4l2Device meta;
+  meta.device_caps = V4L2_CAP_META_CAPTURE | V4L2_CAP_STREAMING;
+  meta.meta_formats = {fourcc('D', '4', 'X', 'X')};
+  ASSERT_TRUE(query_v4l2_node(meta, "/dev/video0", info, error)) << error;
+  EXPECT_TRUE(info.meta_capture);
+  ASSERT_EQ(info.formats.size(), 1u);
+  EXPECT_TRUE(info.formats[0].sizes.empty());
+
+  EXPECT_FALSE(query_v4l2_node(dev, "/dev/video3", info, error));
+  EXPECT_NE(error.find("/dev/video3: open failed"), std::string::npos) << error;
+}
+
+TEST(V4l2Enumerate, ListsVideoNodesInNumericOrder) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("posed-dev-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const char* n : {"video10", "video2", "video0", "videoX", "vhci", "video"}) {
+    std::ofstream(dir / n).put('x');
+  }
+  const auto nodes = list_v4l2_nodes(dir.string());
+  ASSERT_EQ(nodes.size(), 3u);
+  EXPECT_EQ(fs::path(nodes[0]).filename(), "video0");
+  EXPECT_EQ(fs::path(nodes[1]).filename(), "video2");
+  EXPECT_EQ(fs::path(nodes[2]).filename(), "video10");
+  fs::remove_all(dir);
 }
 
 }  // namespace

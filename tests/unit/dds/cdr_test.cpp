@@ -300,6 +300,12 @@ TEST_F(CdrLoop, StatusRoundTripsWithStreams) {
   in.header = {{1, 2}, frame};
   in.version = version;
   in.estimator_mode = mode;
+  char fused[] = "fused";
+  in.camera.mode = fused;
+  in.camera.frames = 42;
+  in.camera.features = 250;
+  in.camera.confidence[2] = 0.75;
+  in.camera.omega[0] = 80.5;
   in.uptime_s = 3600.25;
   in.summary = summary;
   in.streams._buffer = streams;
@@ -311,6 +317,11 @@ TEST_F(CdrLoop, StatusRoundTripsWithStreams) {
   EXPECT_STREQ(out.header.frame_id, "map");
   EXPECT_STREQ(out.version, "posed 0.1.0");
   EXPECT_STREQ(out.estimator_mode, "strapdown");
+  EXPECT_STREQ(out.camera.mode, "fused");
+  EXPECT_EQ(out.camera.frames, 42u);
+  EXPECT_EQ(out.camera.features, 250);
+  EXPECT_EQ(out.camera.confidence[2], 0.75);
+  EXPECT_EQ(out.camera.omega[0], 80.5);
   EXPECT_EQ(out.uptime_s, 3600.25);
   EXPECT_STREQ(out.summary, "2 streams");
   ASSERT_EQ(out.streams._length, 2u);

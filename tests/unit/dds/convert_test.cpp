@@ -85,6 +85,14 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   msg.estimator.degenerate_directions = 1;
   msg.estimator.gyro_bias_radps = {0.001, -0.002, 0.003};
   msg.estimator.accel_bias_mps2 = {0.04, -0.05, 0.06};
+  msg.camera.mode = "fused";
+  msg.camera.frames = 300;
+  msg.camera.frames_unusable = 3;
+  msg.camera.features = 287;
+  msg.camera.depth_associated = 120;
+  msg.camera.match_success_rate = 0.93;
+  msg.camera.confidence = {0.1, 0.5, 0.6};
+  msg.camera.omega = {90.0, 2.0, 1.5};
   msg.uptime_s = 12.5;
   msg.summary = "ok";
   for (const char* name : {"imu", "lidar", "color"}) {
@@ -122,6 +130,14 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   EXPECT_EQ(back.estimator.degenerate_directions, 1);
   EXPECT_EQ(back.estimator.gyro_bias_radps, msg.estimator.gyro_bias_radps);
   EXPECT_EQ(back.estimator.accel_bias_mps2, msg.estimator.accel_bias_mps2);
+  EXPECT_EQ(back.camera.mode, "fused");
+  EXPECT_EQ(back.camera.frames, 300u);
+  EXPECT_EQ(back.camera.frames_unusable, 3u);
+  EXPECT_EQ(back.camera.features, 287);
+  EXPECT_EQ(back.camera.depth_associated, 120);
+  EXPECT_EQ(back.camera.match_success_rate, 0.93);
+  EXPECT_EQ(back.camera.confidence, msg.camera.confidence);
+  EXPECT_EQ(back.camera.omega, msg.camera.omega);
   EXPECT_EQ(back.uptime_s, msg.uptime_s);
   EXPECT_EQ(back.summary, msg.summary);
   ASSERT_EQ(back.streams.size(), 3u);

@@ -1,0 +1,173 @@
+#include "core/fusion/camera_front_end.hpp"
+
+#include <algorithm>
+
+#include "core/fusion/gyro_rotation.hpp"
+
+namespace posed::fusion {
+
+namespace {
+
+constexpr std::size_t kImuCapacity = 2000;  // > 10 s at 150-200 Hz: covers any frame latency
+constexpr std::size_t kPoseCapacity = 2048;
+
+DepthCloudConfig depth_config(const CameraFrontEndConfig& c) {
+  DepthCloudConfig d = c.depth;
+  // The camera's optical axis (z) in the lidar frame.
+  d.view_axis_lidar = (c.T_imu_lidar.linear().transpose() * c.T_imu_cam.linear()).col(2);
+  return d;
+}
+
+StreamQualityFigures quality_figures(const vision::ImageQuality& q) {
+  return {q.valid, q.gradient_metric, q.noise_sigma, q.confidence, q.omega};
+}
+
+}  // namespace
+
+CameraFrontEnd::CameraFrontEnd(const CameraFrontEndConfig& config)
+    : config_(config),
+      pairer_(config.pairing),
+      imu_(ImuBufferConfig{.capacity = kImuCapacity}),
+      poses_(
+          PoseHistoryConfig{.capacity = kPoseCapacity, .max_extrapolation = Duration::from_ms(50)}),
+      depth_(depth_config(config)) {
+  scratch_.reserve(imu_.capacity());
+  std::vector<vision::FrontendMode> modes{config.frontend.mode};
+  modes.insert(modes.end(), config.compare_modes.begin(), config.compare_modes.end());
+  for (const vision::FrontendMode mode : modes) {
+    vision::FrontendConfig c = config.frontend;
+    c.mode = mode;
+    Run run;
+    run.frontend = std::make_unique<vision::VisualFrontend>(c);
+    run.figures.mode = vision::to_string(mode);
+    runs_.push_back(std::move(run));
+  }
+}
+
+CameraFrontEnd::~CameraFrontEnd() = default;
+
+void CameraFrontEnd::add_imu(const ImuSample& sample) { imu_.push(sample); }
+
+void CameraFrontEnd::add_state(const NavState& state) {
+  // Propagated and optimised states interleave out of stamp order (an optimised state lands on
+  // a scan's end, behind the propagation); the history keeps the stamp-ordered ones, which is
+  // all the depth cloud needs (its points tolerate centimetres).
+  poses_.push(Pose{state.stamp, state.p_map_base_m, state.q_map_base});
+}
+
+void CameraFrontEnd::add_scan(const MatchedScan& scan) {
+  if (scan.index == last_scan_index_) return;
+  last_scan_index_ = scan.index;
+  depth_.add_scan(scan.stamp, scan.T_map_lidar, scan.points_lidar);
+}
+
+void CameraFrontEnd::add_image(CameraStream stream, Image image) {
+  if (stream == CameraStream::kVisible) {
+    pairer_.push_visible(std::move(image));
+  } else {
+    pairer_.push_thermal(std::move(image));
+  }
+}
+
+void CameraFrontEnd::process(const Eigen::Vector3d& gyro_bias_radps) {
+  std::optional<HostTime> watermark;
+  if (!imu_.empty()) watermark = imu_.newest_stamp() - config_.arrival_lag;
+  while (auto released = pairer_.pop(watermark)) {
+    if (!released->visible && config_.has_visible) continue;  // a thermal frame nobody pairs
+    Event e;
+    e.stamp = released->visible ? released->visible->stamp : released->thermal->stamp;
+    e.latest = e.stamp;
+    if (released->thermal) e.latest = std::max(e.latest, released->thermal->stamp);
+    e.visible = std::move(released->visible);
+    e.thermal = std::move(released->thermal);
+    ready_.push_back(std::move(e));
+  }
+  while (!ready_.empty() && imu_.covers(ready_.front().latest)) {
+    run_event(ready_.front(), gyro_bias_radps);
+    ready_.pop_front();
+  }
+  // Events the IMU can no longer cover (it jumped past them, or restarted) would wait forever.
+  while (ready_.size() > 2 * config_.pairing.pending_capacity) {
+    for (Run& run : runs_) ++run.figures.frames_without_imu;
+    ready_.pop_front();
+  }
+  if (!imu_.empty()) imu_.discard_before(imu_.newest_stamp() - Duration::from_s(2));
+}
+
+void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps) {
+  vision::FrontendInput input =
+      vision::make_input(e.visible ? &*e.visible : nullptr, e.thermal ? &*e.thermal : nullptr);
+  input.visible_stamp = e.visible ? e.visible->stamp : e.stamp;
+  input.thermal_stamp = e.thermal ? e.thermal->stamp : e.stamp;
+  if (e.visible && e.thermal) {
+    const std::optional<Eigen::Matrix3d> R_btv_btt =
+        gyro_rotation(imu_, input.visible_stamp, input.thermal_stamp, gyro_bias_radps, scratch_);
+    if (!R_btv_btt) {
+      for (Run& run : runs_) ++run.figures.frames_without_imu;
+      return;
+    }
+    const Eigen::Matrix3d R_imu_cam = config_.T_imu_cam.linear();
+    input.R_camtv_camtt = R_imu_cam.transpose() * *R_btv_btt * R_imu_cam;
+  }
+  // Depth: the stacked lidar points in the camera frame at the tracked image's stamp, when the
+  // estimator has a pose there (none before it is aligned, or without a lidar).
+  p_cam_m_.clear();
+  if (depth_.scans() > 0) {
+    if (const std::optional<Pose> T = poses_.at(e.stamp)) {
+      const Eigen::Isometry3d T_map_base = Eigen::Translation3d(T->p) * T->q.normalized();
+      depth_.points_in_camera(e.stamp, T_map_base * config_.T_imu_cam, p_cam_m_);
+    }
+  }
+  input.p_cam_m = p_cam_m_;
+  for (Run& run : runs_) {
+    const vision::FrontendMode mode = run.frontend->config().mode;
+    const bool usable = (mode != vision::FrontendMode::kVisible || e.visible) &&
+                        (mode != vision::FrontendMode::kThermal || e.thermal) &&
+                        (mode != vision::FrontendMode::kFused || (e.visible && e.thermal));
+    if (!usable) {
+      ++run.figures.frames_unusable;
+      continue;
+    }
+    const vision::FrontendStatus status = run.frontend->process(input, run.frame);
+    account(run, status);
+    if (status == vision::FrontendStatus::kOk && observer_ != nullptr) {
+      observer_->on_frame(run.frame, *run.frontend);
+    }
+  }
+}
+
+void CameraFrontEnd::account(Run& run, vision::FrontendStatus status) {
+  CameraFigures& f = run.figures;
+  if (status != vision::FrontendStatus::kOk) {
+    ++f.frames_unusable;
+    return;
+  }
+  const vision::FrontendFrame& frame = run.frame;
+  ++f.frames;
+  f.previous_total += static_cast<std::uint64_t>(frame.counts.previous);
+  f.inliers_total += static_cast<std::uint64_t>(frame.counts.ransac_inliers);
+  f.extracted_total += static_cast<std::uint64_t>(frame.counts.extracted);
+  f.features_total += static_cast<std::uint64_t>(frame.counts.features);
+  f.depth_total += static_cast<std::uint64_t>(frame.counts.depth_associated);
+  f.features = frame.counts.features;
+  f.depth_associated = frame.counts.depth_associated;
+  f.lidar_points = frame.counts.lidar_points;
+  const vision::ImageQuality* q[3] = {&frame.quality.visible, &frame.quality.thermal,
+                                      &frame.quality.fused};
+  for (std::size_t i = 0; i < 3; ++i) {
+    f.quality[i] = quality_figures(*q[i]);
+    if (!q[i]->valid) continue;
+    ++f.quality_frames[i];
+    // Running mean, exact for any count.
+    f.mean_confidence[i] +=
+        (q[i]->confidence - f.mean_confidence[i]) / static_cast<double>(f.quality_frames[i]);
+  }
+}
+
+std::vector<CameraFigures> CameraFrontEnd::compare_figures() const {
+  std::vector<CameraFigures> out;
+  for (std::size_t i = 1; i < runs_.size(); ++i) out.push_back(runs_[i].figures);
+  return out;
+}
+
+}  // namespace posed::fusion

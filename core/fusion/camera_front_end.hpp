@@ -1,0 +1,115 @@
+#pragma once
+// The camera side of the fusion core (issue 9): visible and thermal frames paired by stamp
+// (StreamPairer), the thermal frame's rotation to its partner's stamp from the gyro, recent
+// lidar points in the camera frame for depth (DepthCloud, at the pose the estimator gives for
+// the frame's stamp), and the visual-thermal front end (core/vision) run on each visible frame
+// event. Pure and deterministic like the rest of the core: it runs on the fusion thread, in the
+// order the fusion stage hands measurements over.
+//
+// Events. The front end runs at the visible camera's rate in every mode, so the three modes see
+// the same events and compare (the paper's Table 2): visible mode uses the visible frame,
+// thermal mode its thermal partner (registered into the visible frame), fused mode both. A rig
+// without a visible camera runs thermal mode on every thermal frame. An event is processed once
+// the IMU covers both its stamps (the rotation between them is integrated from the gyro).
+//
+// Its output, per frame, is the features (id, normalised coordinates, depth) and per-stream
+// quality (confidence, covariance scale omega) of seed 002; the figures summarise them.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/estimator/fusion_core.hpp"
+#include "core/fusion/depth_cloud.hpp"
+#include "core/measurements.hpp"
+#include "core/sync/imu_buffer.hpp"
+#include "core/sync/pose_interpolation.hpp"
+#include "core/sync/stream_pairer.hpp"
+#include "core/vision/visual_frontend.hpp"
+
+namespace posed::fusion {
+
+struct CameraFrontEndConfig {
+  /// the front end whose output goes to the back end; its `mode` is the primary mode
+  vision::FrontendConfig frontend;
+  /// further front ends run on the same events in these modes, for comparison only
+  /// (`posectl inspect frontend`); their figures are in compare_figures()
+  std::vector<vision::FrontendMode> compare_modes;
+  /// the visible camera in the IMU (base_link) frame
+  Eigen::Isometry3d T_imu_cam = Eigen::Isometry3d::Identity();
+  /// the lidar in the IMU frame (the depth cloud keeps points in front of the camera)
+  Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
+  /// which cameras the rig has (a rig without a visible camera runs thermal mode per frame)
+  bool has_visible = true;
+  bool has_thermal = true;
+  /// |thermal - visible| of a pair, and the frames each stream may hold pending
+  StreamPairerConfig pairing{.tolerance = Duration::from_ms(20), .pending_capacity = 3};
+  /// How far behind the newest IMU sample a frame may still arrive [ns]: 0 when the fusion
+  /// stage hands measurements over in stamp order (replays); live, the cameras' latency.
+  Duration arrival_lag = Duration::from_ns(0);
+  DepthCloudConfig depth;
+};
+
+/// Sees every frame a front end processed, with the front end (its images), e.g. to annotate.
+class FrontendObserver {
+ public:
+  virtual ~FrontendObserver() = default;
+  virtual void on_frame(const vision::FrontendFrame& frame,
+                        const vision::VisualFrontend& frontend) = 0;
+};
+
+class CameraFrontEnd {
+ public:
+  explicit CameraFrontEnd(const CameraFrontEndConfig& config);
+  ~CameraFrontEnd();
+  CameraFrontEnd(const CameraFrontEnd&) = delete;
+  CameraFrontEnd& operator=(const CameraFrontEnd&) = delete;
+
+  void add_imu(const ImuSample& sample);
+  /// The estimator's states (poses for the depth cloud's camera pose).
+  void add_state(const NavState& state);
+  /// A scan the estimator matched (its points join the depth cloud).
+  void add_scan(const MatchedScan& scan);
+  void add_image(CameraStream stream, Image image);
+  /// Processes every event that can be decided and that the IMU covers.
+  void process(const Eigen::Vector3d& gyro_bias_radps);
+
+  void set_observer(FrontendObserver* observer) { observer_ = observer; }
+  /// The primary front end's figures.
+  const CameraFigures& figures() const { return runs_.front().figures; }
+  /// The comparison front ends' figures, in compare_modes order.
+  std::vector<CameraFigures> compare_figures() const;
+  const StreamPairerCounters& pairing() const { return pairer_.counters(); }
+
+ private:
+  struct Event {
+    std::optional<Image> visible;
+    std::optional<Image> thermal;
+    HostTime stamp;   // the tracked image's: the visible frame's, else the thermal frame's
+    HostTime latest;  // the later of the two stamps: the IMU must cover it
+  };
+  struct Run {
+    std::unique_ptr<vision::VisualFrontend> frontend;
+    vision::FrontendFrame frame;
+    CameraFigures figures;
+  };
+  void run_event(Event& event, const Eigen::Vector3d& gyro_bias_radps);
+  void account(Run& run, vision::FrontendStatus status);
+
+  CameraFrontEndConfig config_;
+  StreamPairer<Image, Image> pairer_;
+  ImuBuffer imu_;
+  PoseHistory poses_;
+  DepthCloud depth_;
+  std::deque<Event> ready_;
+  std::vector<Run> runs_;  // the primary first, then compare_modes
+  FrontendObserver* observer_ = nullptr;
+  std::uint64_t last_scan_index_ = 0;
+  std::vector<ImuSample> scratch_;
+  std::vector<Eigen::Vector3f> p_cam_m_;
+};
+
+}  // namespace posed::fusion

@@ -1,0 +1,127 @@
+#pragma once
+// The visual-thermal front end (issue 9): seeds 000, 001 and 002 composed.
+//
+//   visible (BGR/RGB/grey) -> enhance (001) ----------------------+
+//                                                                   +-> DWT fusion (000)
+//   thermal (8/16-bit) -> one remap: undistort, FOV (000 eq. 1-6),  |   -> KLT + RANSAC (001)
+//                         resample, register, inter-stamp rotation -+   -> lidar depth (000)
+//   image quality (002) of every stream built -> confidence and covariance weight omega
+//
+// Pure and deterministic: no clock, no I/O, no threads of its own (OpenCV's functions may use
+// its internal thread pool; the runner decides with cv::setNumThreads), state only in the
+// trackers and reusable buffers. Every image stays in the visible camera's pixel grid, so the
+// features of all three modes share one camera model.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
+#include <opencv2/core/mat.hpp>
+#include <span>
+
+#include "core/measurements.hpp"
+#include "core/vision/depth_associator.hpp"
+#include "core/vision/dwt_fusion.hpp"
+#include "core/vision/enhancer.hpp"
+#include "core/vision/feature_tracker.hpp"
+#include "core/vision/frontend_frame.hpp"
+#include "core/vision/image_quality.hpp"
+#include "core/vision/line_tracker.hpp"
+#include "core/vision/pinhole_camera.hpp"
+#include "core/vision/thermal_aligner.hpp"
+
+namespace posed::vision {
+
+struct FrontendConfig {
+  FrontendMode mode = FrontendMode::kFused;
+  PinholeCamera visible_camera;  ///< the D435i colour camera (M2DGR: 640x480)
+  PinholeCamera thermal_camera;  ///< the PLUG 617 (M2DGR: 640x512)
+  /// thermal camera pose in the visible camera frame (p_cam = T_cam_thermal p_thermal)
+  Eigen::Isometry3d T_cam_thermal = Eigen::Isometry3d::Identity();
+  EnhanceConfig visible_enhance;        ///< seed 001's enhancement of the visible stream
+  EnhanceConfig thermal_enhance = [] {  ///< off by default: seed 000 fuses the thermal as is
+    EnhanceConfig c;
+    c.enabled = false;
+    return c;
+  }();
+  ThermalAlignConfig thermal_align;
+  FusionConfig fusion;
+  bool assess_quality = true;
+  QualityConfig quality;
+  TrackerConfig tracker;
+  bool lines = false;  ///< LSD line features (seed 001); several ms per frame
+  LineConfig line;
+  DepthConfig depth;
+};
+
+/// One frame pair. cv::Mat headers may wrap driver buffers (see image_view.hpp); nothing is
+/// kept after process() returns.
+struct FrontendInput {
+  HostTime visible_stamp;  ///< exposure midpoint of the visible frame
+  HostTime thermal_stamp;  ///< exposure midpoint of the thermal frame
+  cv::Mat visible;  ///< CV_8UC3 (B,G,R; R,G,B when visible_rgb) or CV_8UC1; any mode but kThermal
+  bool visible_rgb = false;
+  cv::Mat thermal;  ///< CV_8UC1 (AGC'd video) or CV_16UC1 (raw counts); any mode but kVisible
+  /// camera rotation between the stamps: directions in the camera frame at the thermal stamp ->
+  /// the camera frame at the visible stamp (see ThermalAligner::align); identity if unknown
+  Eigen::Matrix3d R_camtv_camtt = Eigen::Matrix3d::Identity();
+  /// recent deskewed lidar points in the visible camera frame at the tracked image's stamp [m];
+  /// empty: no depth this frame
+  std::span<const Eigen::Vector3f> p_cam_m;
+};
+
+/// Wraps core Images (either may be null) into an input without copying their pixels.
+FrontendInput make_input(const Image* visible, const Image* thermal);
+
+class VisualFrontend {
+ public:
+  /// Throws std::invalid_argument when a camera the mode uses has no valid intrinsics.
+  explicit VisualFrontend(const FrontendConfig& config);
+  ~VisualFrontend();
+  VisualFrontend(const VisualFrontend&) = delete;
+  VisualFrontend& operator=(const VisualFrontend&) = delete;
+
+  /// Optional: called around every step of every frame (null: none).
+  void set_probe(FrontendStepProbe* probe) { probe_ = probe; }
+
+  /// Processes one frame pair into `out` (its vectors' capacity is reused). On a status other
+  /// than kOk nothing is tracked and the trackers keep their state for the next frame.
+  FrontendStatus process(const FrontendInput& input, FrontendFrame& out);
+
+  /// The grey images of the last frame (visible size), for inspection and annotation; empty for
+  /// streams the mode does not build.
+  const cv::Mat& visible_grey() const { return visible_grey_; }
+  const cv::Mat& thermal_grey() const { return thermal_grey_; }
+  const cv::Mat& fused_grey() const { return fused_grey_; }
+  /// The image the features were tracked on.
+  const cv::Mat& tracked_grey() const;
+
+  const FrontendConfig& config() const { return config_; }
+
+ private:
+  void begin(FrontendStep s) {
+    if (probe_ != nullptr) probe_->begin(s);
+  }
+  void end(FrontendStep s) {
+    if (probe_ != nullptr) probe_->end(s);
+  }
+
+  FrontendConfig config_;
+  Enhancer visible_enhancer_;
+  Enhancer thermal_enhancer_;
+  std::unique_ptr<ThermalAligner> aligner_;  // only when the mode uses the thermal stream
+  DwtFusion fusion_;
+  QualityAssessor quality_;
+  FeatureTracker tracker_;
+  LineTracker line_tracker_;
+  DepthAssociator depth_;
+  FrontendStepProbe* probe_ = nullptr;
+
+  cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, thermal_native_, fused_grey_;
+  cv::Mat thermal_native_enhanced_;
+  // previous frame's features (id order) for the velocities
+  std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> previous_;
+  HostTime previous_stamp_;
+  bool has_previous_ = false;
+};
+
+}  // namespace posed::vision

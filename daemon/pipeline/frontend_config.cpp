@@ -1,0 +1,96 @@
+#include "daemon/pipeline/frontend_config.hpp"
+
+#include <algorithm>
+
+#include "daemon/pipeline/estimator_config.hpp"
+
+namespace posed::pipeline {
+
+bool frontend_mode(const std::string& name, vision::FrontendMode& mode) {
+  if (name == "visible") {
+    mode = vision::FrontendMode::kVisible;
+  } else if (name == "thermal") {
+    mode = vision::FrontendMode::kThermal;
+  } else if (name == "fused") {
+    mode = vision::FrontendMode::kFused;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+vision::PinholeCamera pinhole(const config::CameraSection& c) {
+  vision::PinholeCamera p;
+  p.width = c.width;
+  p.height = c.height;
+  p.fx = c.fx;
+  p.fy = c.fy;
+  p.cx = c.cx;
+  p.cy = c.cy;
+  p.k1 = c.k1;
+  p.k2 = c.k2;
+  p.p1 = c.p1;
+  p.p2 = c.p2;
+  return p;
+}
+
+fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& config,
+                                                     bool has_visible, bool has_thermal,
+                                                     bool in_stamp_order, std::string& note) {
+  const config::FrontendSection& s = config.frontend;
+  fusion::CameraFrontEndConfig c;
+  vision::FrontendConfig& f = c.frontend;
+  if (!frontend_mode(s.mode, f.mode)) f.mode = vision::FrontendMode::kFused;
+  note.clear();
+  if (!has_visible && f.mode != vision::FrontendMode::kThermal) {
+    note = "no visible camera: the front end runs in thermal mode instead of " + s.mode;
+    f.mode = vision::FrontendMode::kThermal;
+  } else if (!has_thermal && f.mode != vision::FrontendMode::kVisible) {
+    note = "no thermal camera: the front end runs in visible mode instead of " + s.mode;
+    f.mode = vision::FrontendMode::kVisible;
+  }
+  f.visible_camera = pinhole(config.visible_camera);
+  f.thermal_camera = pinhole(config.thermal_camera);
+  f.T_cam_thermal = to_isometry(config.extrinsics.T_cam_thermal);
+  f.visible_enhance.enabled = s.enhance_visible;
+  f.visible_enhance.target_mean = s.gamma_target_mean;
+  f.visible_enhance.clahe_clip_limit = s.clahe_clip_limit;
+  if (s.thermal_registration == "plane") {
+    f.thermal_align.mode = vision::AlignMode::kPlane;
+  } else if (s.thermal_registration == "fov_crop") {
+    f.thermal_align.mode = vision::AlignMode::kFovCrop;
+  } else {
+    f.thermal_align.mode = vision::AlignMode::kInfiniteHomography;
+  }
+  f.thermal_align.plane_depth_m = s.thermal_plane_depth_m;
+  f.thermal_align.rotation_compensation = s.rotation_compensation;
+  if (s.wavelet == "legall53") {
+    f.fusion.wavelet = vision::Wavelet::kLeGall53;
+  } else if (s.wavelet == "cdf97") {
+    f.fusion.wavelet = vision::Wavelet::kCdf97;
+  } else {
+    f.fusion.wavelet = vision::Wavelet::kHaar;
+  }
+  f.tracker.max_features = s.max_features;
+  f.tracker.min_distance_px = s.min_feature_distance_px;
+  f.tracker.ransac_threshold_px = s.ransac_threshold_px;
+  f.lines = s.lines;
+  f.depth.max_span_m = s.depth_max_span_m;
+
+  c.T_imu_cam = to_isometry(config.extrinsics.T_imu_cam);
+  c.T_imu_lidar = to_isometry(config.extrinsics.T_imu_lidar);
+  c.has_visible = has_visible;
+  c.has_thermal = has_thermal;
+  c.pairing.tolerance = Duration::from_seconds(config.sync.pairing_tolerance_s);
+  // Live, a frame reaches the core its latency after the IMU samples around its exposure.
+  c.arrival_lag =
+      in_stamp_order
+          ? Duration::from_ns(0)
+          : Duration::from_seconds(
+                std::max(config.visible_camera.latency_s, config.thermal_camera.latency_s) + 0.05);
+  c.depth.window = Duration::from_seconds(s.depth_window_s);
+  c.depth.max_points_per_scan = static_cast<std::size_t>(s.depth_points_per_scan);
+  return c;
+}
+
+}  // namespace posed::pipeline

@@ -1,0 +1,45 @@
+#pragma once
+// What the recording and hardware-in-the-loop tests share: a DDS domain of their own and free
+// UDP ports for a live posed to listen on.
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <string>
+
+namespace posed::testing::hil_helpers {
+
+// 1..99 like the other integration tests; +75 keeps these apart from the daemon (+0), lio (+25)
+// and replay (+50) tests of a process with the same id.
+inline int test_domain() { return 1 + static_cast<int>((::getpid() + 75) % 99); }
+
+/// A UDP port nobody uses right now (the kernel's pick of an ephemeral port, released again).
+inline std::uint16_t free_udp_port() {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t len = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+/// The DDS and sensor part of a live posed's config: loopback DDS on the test's domain.
+inline std::string dds_config(const std::string& source_dir) {
+  return "dds:\n  domain_id: " + std::to_string(test_domain()) +
+         "\n  cyclonedds_config: " + source_dir + "/config/cyclonedds-loopback.xml\n";
+}
+
+/// The number after `label` in `text` (e.g. "udp data            22605 packets"), or -1.
+inline long long number_after(const std::string& text, const std::string& label) {
+  const auto at = text.find(label);
+  if (at == std::string::npos) return -1;
+  return std::atoll(text.c_str() + at + label.size());
+}
+
+}  // namespace posed::testing::hil_helpers

@@ -1,0 +1,206 @@
+// posectl record as a user runs it: the synthetic A9 and a live UDP lidar fed by a sender in
+// this test, recorded without decoding or fusion until SIGINT; the file is closed and indexed,
+// holds exactly the bytes sent, carries the same channel metadata posed --record writes, and
+// `posed --replay` takes it through the whole pipeline.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <thread>
+
+#include "drivers/recording/mcap_reader.hpp"
+#include "tests/integration/hil_helpers.hpp"
+#include "tests/integration/posed_process.hpp"
+#include "tests/unit/velodyne/packet_builder.hpp"
+
+namespace posed::testing {
+namespace record_test {
+
+using namespace std::chrono_literals;
+using namespace hil_helpers;
+namespace rec = drivers::recording;
+
+/// Sends VLP-32C data packets (a spinning head at 600 rpm seeing a wall at 10 m) and a few
+/// position packets from 127.0.0.1, as the sensor would, at about the sensor's rate.
+struct LidarSender {
+  std::vector<std::vector<std::byte>> data, position;
+
+  void run(std::uint16_t data_port, std::uint16_t position_port, int packets) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    auto send_to = [&](std::uint16_t port, const std::vector<std::byte>& bytes) {
+      sockaddr_in to{};
+      to.sin_family = AF_INET;
+      to.sin_port = htons(port);
+      to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+      ::sendto(fd, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    };
+    for (int i = 0; i < packets; ++i) {
+      test::PacketSpec spec;
+      // 12 firings of 0.199 deg per packet at 1507 packets/s: 600 rpm.
+      spec.azimuth_cdeg = static_cast<std::uint32_t>(i * 12 * 20) % 36000;
+      spec.time_us = 1'000'000 + static_cast<std::uint32_t>(i * 663);
+      data.push_back(test::make_packet(spec));
+      send_to(data_port, data.back());
+      if (i % 500 == 0) {
+        std::vector<std::byte> p(512, std::byte{0});
+        p[200] = static_cast<std::byte>(i & 0xFF);
+        position.push_back(p);
+        send_to(position_port, p);
+      }
+      // About 1500 packets/s, in bursts of 15 every 10 ms.
+      if (i % 15 == 14) std::this_thread::sleep_for(10ms);
+    }
+    ::close(fd);
+  }
+};
+
+std::string meta(const rec::McapChannelRecord& c, const std::string& key) {
+  const auto it = c.metadata.find(key);
+  return it == c.metadata.end() ? std::string() : it->second;
+}
+
+TEST(PosectlRecord, RecordsTheSourcesUntilSigintAndPosedReplaysTheFile) {
+  TempDir dir;
+  const std::uint16_t data_port = free_udp_port();
+  const std::uint16_t position_port = free_udp_port();
+  const std::string config =
+      dir.write("posed.yaml", dds_config(source_dir()) +
+                                  "imu:\n  source: synthetic\n"
+                                  "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n"
+                                  "lidar:\n  enabled: true\n  source: udp\n  address: 127.0.0.1\n"
+                                  "  data_port: " +
+                                  std::to_string(data_port) +
+                                  "\n  position_port: " + std::to_string(position_port) + "\n" +
+                                  "estimator:\n  init_static_s: 0.5\n");
+  const std::string recording = dir.file("run.mcap");
+  TempDir record_dir;
+  PosedProcess record(
+      {build_dir() + "/tools/posectl/posectl", "record", "-o", recording, "--config", config}, {},
+      record_dir);
+  // The sockets are open once it says what it records.
+  const auto ready_by = std::chrono::steady_clock::now() + 20s;
+  while (record.err().find("recording imu, lidar") == std::string::npos &&
+         std::chrono::steady_clock::now() < ready_by) {
+    ASSERT_FALSE(record.wait_for_exit(20ms).has_value()) << record.err();
+  }
+  ASSERT_NE(record.err().find("recording imu, lidar"), std::string::npos) << record.err();
+
+  LidarSender sender;
+  sender.run(data_port, position_port, 4500);  // 3 s
+  std::this_thread::sleep_for(500ms);          // the last datagrams reach the Recorder
+  record.signal(SIGINT);
+  ASSERT_EQ(record.wait_for_exit(30s), 0) << record.err();
+  const std::string summary = record.out();
+  EXPECT_NE(summary.find("stopped by          Interrupt"), std::string::npos) << summary;
+  EXPECT_EQ(number_after(summary, "  lidar               "), 4500) << summary;
+  EXPECT_NE(summary.find("MB"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("Hz mean"), std::string::npos) << summary;
+  // Progress went to stderr about once a second while it ran.
+  EXPECT_NE(record.err().find("MB on disk | imu"), std::string::npos) << record.err();
+
+  // Closed and indexed: the summary section is there and its CRC holds.
+  rec::McapReader reader;
+  std::string error;
+  ASSERT_TRUE(reader.open(recording, error)) << error;
+  EXPECT_TRUE(reader.summary().usable());
+  std::map<std::string, std::vector<std::vector<std::byte>>> by_topic;
+  rec::McapMessage m;
+  while (reader.next(m)) by_topic[m.channel->topic].emplace_back(m.data.begin(), m.data.end());
+  EXPECT_TRUE(reader.complete()) << reader.stop_reason();
+  ASSERT_EQ(by_topic["/posed/raw/lidar"].size(), sender.data.size());
+  EXPECT_TRUE(by_topic["/posed/raw/lidar"] == sender.data) << "lidar bytes differ from those sent";
+  EXPECT_TRUE(by_topic["/posed/raw/lidar/1"] == sender.position);
+  EXPECT_GT(by_topic["/posed/raw/imu"].size(), 200u);  // 200 Hz for the whole run
+
+  // The channel records of posed --record (pipeline::recording_metadata).
+  for (const auto& [id, c] : reader.channels()) {
+    EXPECT_NE(meta(c, "posed.config").find("lidar:"), std::string::npos) << c.topic;
+    if (c.topic == "/posed/raw/lidar") {
+      EXPECT_EQ(meta(c, "posed.wire_format"), "velodyne-udp-data");
+      EXPECT_EQ(meta(c, "posed.lidar.address"), "127.0.0.1");
+    }
+    if (c.topic == "/posed/raw/imu") {
+      EXPECT_EQ(meta(c, "posed.wire_format"), "a9-serial");
+      EXPECT_EQ(meta(c, "posed.imu.source"), "synthetic");
+    }
+  }
+
+  // posectl inspect FILE.mcap lists it: the lidar channel with what was sent, and no error.
+  {
+    TempDir inspect_dir;
+    PosedProcess inspect({build_dir() + "/tools/posectl/posectl", "inspect", recording}, {},
+                         inspect_dir);
+    ASSERT_EQ(inspect.wait_for_exit(30s), 0) << inspect.out() << inspect.err();
+    const std::string listing = inspect.out();
+    const auto lidar = listing.find("/posed/raw/lidar\n");
+    ASSERT_NE(lidar, std::string::npos) << listing;
+    EXPECT_EQ(number_after(listing.substr(lidar), "messages "), 4500) << listing;
+    EXPECT_NE(listing.find("state    complete"), std::string::npos) << listing;
+    EXPECT_EQ(listing.find("errors ("), std::string::npos) << listing;
+  }
+
+  // posed takes the file: every recorded lidar packet and IMU frame is decoded again.
+  TempDir replay_dir;
+  PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
+                      "--max-speed", "--wait-subscribers", "0"},
+                     {}, replay_dir);
+  ASSERT_EQ(posed.wait_for_exit(60s), 0) << posed.err();
+  const std::string out = posed.out();
+  EXPECT_EQ(number_after(out, "  lidar               "), 4500) << out;
+  EXPECT_EQ(number_after(out, "  imu                 "),
+            static_cast<long long>(by_topic["/posed/raw/imu"].size()))
+      << out;
+  EXPECT_NE(out.find("lidar scans"), std::string::npos) << out;
+}
+
+TEST(PosectlRecord, DurationAndSplitSizeMakeSeveralCompleteFiles) {
+  TempDir dir;
+  const std::string config =
+      dir.write("posed.yaml", dds_config(source_dir()) + "imu:\n  source: synthetic\n" +
+                                  "synthetic_imu:\n  rate_hz: 1000\n");
+  const std::string recording = dir.file("split.mcap");
+  TempDir record_dir;
+  // The synthetic A9 gives ~49 kB/s at 1000 Hz; 0.02 MB files rotate every ~0.4 s.
+  PosedProcess record({build_dir() + "/tools/posectl/posectl", "record", "-o", recording,
+                       "--config", config, "--duration", "2", "--split-size", "0.02"},
+                      {}, record_dir);
+  ASSERT_EQ(record.wait_for_exit(30s), 0) << record.err();
+  EXPECT_NE(record.out().find("stopped by          --duration"), std::string::npos) << record.out();
+  std::vector<std::string> files = {recording};
+  for (int i = 1;; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "split_%03d.mcap", i);  // the Recorder's rotation names
+    if (!std::filesystem::exists(dir.file(name))) break;
+    files.push_back(dir.file(name));
+  }
+  ASSERT_GE(files.size(), 3u) << record.out();
+  std::uint64_t total = 0;
+  for (const auto& f : files) {
+    rec::McapReader reader;
+    std::string error;
+    ASSERT_TRUE(reader.open(f, error)) << error;
+    EXPECT_TRUE(reader.summary().usable()) << f;
+    rec::McapMessage m;
+    while (reader.next(m)) ++total;
+    EXPECT_TRUE(reader.complete()) << f << ": " << reader.stop_reason();
+  }
+  EXPECT_EQ(static_cast<long long>(total), number_after(record.out(), "  imu                 "));
+}
+
+TEST(PosectlRecord, ABadConfigIsRefusedNamingTheKey) {
+  TempDir dir;
+  const std::string config = dir.write("posed.yaml", "imu:\n  sourcee: synthetic\n");
+  PosedProcess record({build_dir() + "/tools/posectl/posectl", "record", "-o", dir.file("x.mcap"),
+                       "--config", config},
+                      {}, dir);
+  ASSERT_EQ(record.wait_for_exit(10s), 2);
+  EXPECT_NE(record.err().find("imu.sourcee"), std::string::npos) << record.err();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.mcap")));
+}
+
+}  // namespace record_test
+}  // namespace posed::testing

@@ -1,0 +1,178 @@
+// The camera front end of the fusion core on a scene known exactly: the M2DGR rig's colour and
+// thermal cameras, standing still, look at a textured wall 6 m ahead that the lidar also sees.
+// Frames, IMU samples, states and scans are handed over in stamp order as the fusion stage does.
+
+#include "core/fusion/camera_front_end.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "tests/unit/vision/synthetic_scene.hpp"
+
+namespace posed::fusion {
+namespace {
+
+namespace scene = vision::scene;
+constexpr double kWallDepthM = 6.0;
+
+Image to_image(const cv::Mat& grey, HostTime stamp, PayloadPool& pool) {
+  Image image;
+  image.stamp = stamp;
+  image.width = static_cast<std::uint32_t>(grey.cols);
+  image.height = static_cast<std::uint32_t>(grey.rows);
+  image.stride = image.width;
+  image.format = PixelFormat::kMono8;
+  image.pixels = pool.acquire();
+  EXPECT_TRUE(image.pixels.valid());
+  for (int r = 0; r < grey.rows; ++r) {
+    std::memcpy(image.pixels.bytes().data() + static_cast<std::size_t>(r) * image.stride,
+                grey.ptr(r), image.width);
+  }
+  return image;
+}
+
+class CountingObserver final : public FrontendObserver {
+ public:
+  void on_frame(const vision::FrontendFrame& frame,
+                const vision::VisualFrontend& frontend) override {
+    ++frames[frontend.config().mode];
+    for (const auto& f : frame.features) {
+      if (std::isnan(f.depth_m)) continue;
+      ++depths;
+      worst_depth_error_m = std::max(worst_depth_error_m, std::abs(f.depth_m - kWallDepthM));
+    }
+  }
+  std::map<vision::FrontendMode, int> frames;
+  int depths = 0;
+  double worst_depth_error_m = 0;
+};
+
+struct Rig {
+  CameraFrontEndConfig config;
+  Rig() {
+    config.frontend.visible_camera = scene::m2dgr_visible();
+    config.frontend.thermal_camera = scene::m2dgr_thermal();
+    config.frontend.T_cam_thermal = scene::m2dgr_T_cam_thermal();
+    // The IMU, the colour camera and the lidar share one frame here (camera axes).
+  }
+};
+
+/// Hands 3 s of a still rig to `front` in stamp order; returns the visible frames sent.
+int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar) {
+  const auto vis_cam = scene::m2dgr_visible();
+  const auto th_cam = scene::m2dgr_thermal();
+  const cv::Mat visible = scene::render_wall(
+      vis_cam, scene::pixel_rays(vis_cam), Eigen::Isometry3d::Identity(), kWallDepthM, 160, 40, 7);
+  const cv::Mat thermal = scene::render_wall(th_cam, scene::pixel_rays(th_cam),
+                                             scene::m2dgr_T_cam_thermal(), kWallDepthM, 120, 60, 7);
+  PayloadPool visible_pool(16, 640 * 480), thermal_pool(16, 640 * 512);
+  // Events in stamp order: IMU at 200 Hz, visible at 15 Hz (+3 ms), thermal at 25 Hz (+11 ms),
+  // a lidar scan at 10 Hz.
+  std::vector<lidar::ScanPoint> wall;
+  for (int i = -100; i <= 100; ++i) {
+    for (int j = -80; j <= 80; ++j) {
+      lidar::ScanPoint p;
+      p.p = Eigen::Vector3f(0.05f * static_cast<float>(i), 0.05f * static_cast<float>(j),
+                            static_cast<float>(kWallDepthM));
+      wall.push_back(p);
+    }
+  }
+  int visible_sent = 0;
+  std::uint64_t scan_index = 0;
+  int noise_seed = 1;
+  for (std::int64_t t_us = 0; t_us <= 3'000'000; ++t_us) {
+    const HostTime t = HostTime::from_ns(t_us * 1000);
+    if (t_us % 5000 == 0) {
+      ImuSample s;
+      s.stamp = t;
+      s.specific_force_mps2 = Eigen::Vector3d(0, -9.81, 0);
+      front.add_imu(s);
+      NavState state;
+      state.stamp = t;
+      front.add_state(state);
+    }
+    if (with_lidar && t_us % 100'000 == 50'000) {
+      MatchedScan scan;
+      scan.index = ++scan_index;
+      scan.stamp = t;
+      scan.points_lidar = wall;
+      front.add_scan(scan);
+    }
+    if (t_us % 66'667 == 3000) {
+      front.add_image(
+          CameraStream::kVisible,
+          to_image(scene::add_noise(visible, 2.0, static_cast<std::uint64_t>(noise_seed++)), t,
+                   visible_pool));
+      ++visible_sent;
+    }
+    if (with_thermal && t_us % 40'000 == 11'000) {
+      front.add_image(
+          CameraStream::kThermal,
+          to_image(scene::add_noise(thermal, 1.0, static_cast<std::uint64_t>(noise_seed++)), t,
+                   thermal_pool));
+    }
+    if (t_us % 1000 == 0) front.process(Eigen::Vector3d::Zero());
+  }
+  return visible_sent;
+}
+
+TEST(CameraFrontEnd, FusedModeTracksEveryPairedFrameAndTheOtherModesCompareOnTheSameEvents) {
+  Rig rig;
+  rig.config.frontend.mode = vision::FrontendMode::kFused;
+  rig.config.compare_modes = {vision::FrontendMode::kVisible, vision::FrontendMode::kThermal};
+  CameraFrontEnd front(rig.config);
+  CountingObserver observer;
+  front.set_observer(&observer);
+  const int sent = run_still_rig(front, /*with_thermal=*/true, /*with_lidar=*/true);
+
+  const auto& pairing = front.pairing();
+  ASSERT_GT(pairing.paired, 35u);
+  const CameraFigures& fused = front.figures();
+  EXPECT_EQ(fused.mode, "fused");
+  // Every released visible frame is one event; a visible frame near the end may still wait.
+  const std::uint64_t events = pairing.paired + pairing.unpaired_visible;
+  EXPECT_GE(events + 2, static_cast<std::uint64_t>(sent));
+  EXPECT_EQ(fused.frames, pairing.paired);
+  EXPECT_EQ(fused.frames + fused.frames_unusable, events);
+  const std::vector<CameraFigures> compare = front.compare_figures();
+  ASSERT_EQ(compare.size(), 2u);
+  EXPECT_EQ(compare[0].mode, "visible");
+  EXPECT_EQ(compare[0].frames, events);
+  EXPECT_EQ(compare[1].mode, "thermal");
+  EXPECT_EQ(compare[1].frames, pairing.paired);
+  EXPECT_EQ(observer.frames[vision::FrontendMode::kFused], static_cast<int>(fused.frames));
+
+  // A still textured wall: hundreds of features, nearly all tracked from frame to frame.
+  EXPECT_GT(fused.features, 150);
+  EXPECT_GT(fused.match_success_rate(), 0.9);
+  // The wall is in the lidar too: most features get a depth, and the right one.
+  EXPECT_GT(fused.depth_total, fused.features_total / 2);
+  EXPECT_GT(observer.depths, 1000);
+  EXPECT_LT(observer.worst_depth_error_m, 0.05);
+  // Both streams and the fusion were assessed.
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(fused.quality[i].valid) << i;
+    EXPECT_GT(fused.quality_frames[i], 0u) << i;
+  }
+}
+
+TEST(CameraFrontEnd, WithoutThermalFramesFusedEventsAreUnusableAndVisibleModeRuns) {
+  Rig rig;
+  rig.config.frontend.mode = vision::FrontendMode::kFused;
+  rig.config.compare_modes = {vision::FrontendMode::kVisible};
+  CameraFrontEnd front(rig.config);
+  const int sent = run_still_rig(front, /*with_thermal=*/false, /*with_lidar=*/false);
+  const CameraFigures& fused = front.figures();
+  EXPECT_EQ(fused.frames, 0u);
+  EXPECT_GE(fused.frames_unusable + 2, static_cast<std::uint64_t>(sent));
+  const CameraFigures visible = front.compare_figures().at(0);
+  EXPECT_EQ(visible.frames, fused.frames_unusable);
+  EXPECT_GT(visible.features, 150);
+  EXPECT_EQ(visible.depth_total, 0u);  // no lidar, no depth
+}
+
+}  // namespace
+}  // namespace posed::fusion
