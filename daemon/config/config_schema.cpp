@@ -156,6 +156,33 @@ const Field kSchema[] = {
       "counter_us_32bit|us_past_hour|hardware_ns|none",
       "how the camera stamps frames (PLUG 617 over UVC: none, host arrival only)"),
 
+    // The D435i's depth node. M2DGR recorded no depth and published no depth calibration, so
+    // the defaults are a D435's factory calibration at 640x480 (librealsense's sample recording
+    // in shared/realdata/realsense_d435: fx = fy = 390.43, cx 331.39, cy 242.19, baseline
+    // 50.17 mm, depth units 1 mm) and Intel's D435 figures for the working range.
+    F("depth_camera.enabled", depth_camera.enabled, "false", "", 0, 0, "",
+      "simulate and record the D435i depth stream (posed has no depth stage: a replay skips it)"),
+    F("depth_camera.width", depth_camera.width, "640", "px", 1, 1280, "",
+      "depth image width (the D435i sends 640x480 or 848x480 at 15 Hz)"),
+    F("depth_camera.height", depth_camera.height, "480", "px", 1, 800, "", "depth image height"),
+    F("depth_camera.rate_hz", depth_camera.rate_hz, "15", "Hz", 1, 90, "", "depth frame rate"),
+    F("depth_camera.fx", depth_camera.fx, "390.431457519531", "px", 1, 1e5, "",
+      "focal x of the rectified left IR imager"),
+    F("depth_camera.fy", depth_camera.fy, "390.431457519531", "px", 1, 1e5, "", "focal y"),
+    F("depth_camera.cx", depth_camera.cx, "331.387878417969", "px", 0, 1e5, "",
+      "principal point x"),
+    F("depth_camera.cy", depth_camera.cy, "242.187347412109", "px", 0, 1e5, "",
+      "principal point y"),
+    F("depth_camera.baseline_m", depth_camera.baseline_m, "0.0501707", "m", 0.001, 1, "",
+      "stereo baseline from the left to the right IR imager"),
+    F("depth_camera.depth_unit_m", depth_camera.depth_unit_m, "0.001", "m", 1e-6, 0.01, "",
+      "metres per Z16 count (the D435i's default depth units)"),
+    F("depth_camera.min_range_m", depth_camera.min_range_m, "0.155", "m", 0.01, 10, "",
+      "nearer surfaces find no stereo match and read 0 (MinZ = fx * baseline / 126 px of "
+      "disparity search)"),
+    F("depth_camera.max_range_m", depth_camera.max_range_m, "10", "m", 0.1, 65, "",
+      "farther surfaces read 0 (the D435's ideal range ends near 10 m)"),
+
     F("sync.pairing_tolerance_s", sync.pairing_tolerance_s, "0.02", "s", 0.0001, 0.5, "",
       "visible and thermal frames further apart than this are not paired"),
 
@@ -168,6 +195,10 @@ const Field kSchema[] = {
     F("extrinsics.T_cam_thermal", extrinsics.T_cam_thermal,
       "[1, 0, 0, -0.17, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]", "m", 0, 0, "",
       "thermal camera pose in the visible camera frame"),
+    F("extrinsics.T_cam_depth", extrinsics.T_cam_depth,
+      "[1, 0, 0, 0.0143, 0, 1, 0, 0.0006, 0, 0, 1, 0.0006, 0, 0, 0, 1]", "m", 0, 0, "",
+      "depth (left IR) imager pose in the visible camera frame: 14.3 mm to the colour camera's "
+      "right, as the D435's factory calibration records it"),
 
     F("estimator.init_static_s", estimator.init_static_s, "1", "s", 0.05, 30, "",
       "IMU averaged at start for the gravity alignment"),

@@ -87,6 +87,20 @@ struct CameraSection {
   std::string clock_kind;  ///< hardware_ns (D435i metadata) | none (UVC thermal)
 };
 
+/// The D435i's depth node (Z16 from the left IR imager of its stereo pair). posed has no depth
+/// stage yet: the simulator emits this stream and a replay skips it.
+struct DepthCameraSection {
+  bool enabled = false;
+  int width = 0;                          ///< [px]
+  int height = 0;                         ///< [px]
+  double rate_hz = 0;                     ///< [Hz]
+  double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics of the rectified depth image [px]
+  double baseline_m = 0;                  ///< stereo baseline, left to right IR imager [m]
+  double depth_unit_m = 0;                ///< metres per Z16 count [m]
+  double min_range_m = 0;                 ///< nearer: no stereo match, reported 0 [m]
+  double max_range_m = 0;                 ///< farther: reported 0 [m]
+};
+
 struct SyncSection {
   double pairing_tolerance_s = 0.02;  ///< visible/thermal frames further apart are not paired [s]
 };
@@ -95,6 +109,7 @@ struct ExtrinsicsSection {
   Transform4 T_imu_lidar{};
   Transform4 T_imu_cam{};
   Transform4 T_cam_thermal{};
+  Transform4 T_cam_depth{};
 };
 
 struct FrontendSection {
@@ -168,6 +183,7 @@ struct PosedConfig {
   LidarSection lidar;
   CameraSection visible_camera;
   CameraSection thermal_camera;
+  DepthCameraSection depth_camera;
   SyncSection sync;
   ExtrinsicsSection extrinsics;
   EstimatorSection estimator;

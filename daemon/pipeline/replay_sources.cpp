@@ -3,6 +3,7 @@
 #include <charconv>
 #include <set>
 
+#include "drivers/common/log.hpp"
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/mcap_replay_source.hpp"
 #include "drivers/recording/raw_channels.hpp"
@@ -63,13 +64,20 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   out.built.sources.imu = make("imu");
   if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
   // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp).
-  // Other streams (a depth camera, a second IMU) have no stage: listed, not replayed.
+  // Other streams (the D435i's depth, a second IMU) have no stage: listed, said once in the log,
+  // never read.
   const auto replay_camera = [&](const std::string& stream) { return streams.count(stream) != 0; };
   if (replay_camera("visible")) out.built.sources.visible = make("visible");
   if (replay_camera("thermal")) out.built.sources.thermal = make("thermal");
+  std::string skipped;
   for (const auto& s : streams) {
-    const bool replayed = s == "imu" || s == "lidar" || replay_camera(s);
+    const bool replayed = s == "imu" || s == "lidar" || s == "visible" || s == "thermal";
     out.streams += (out.streams.empty() ? "" : ", ") + s + (replayed ? "" : " (not replayed)");
+    if (!replayed) skipped += (skipped.empty() ? "" : ", ") + s;
+  }
+  if (!skipped.empty()) {
+    POSED_LOG_NOTICE("%s: no pipeline stage for stream(s) %s: not replayed", options.path.c_str(),
+                     skipped.c_str());
   }
   return out;
 }

@@ -93,7 +93,8 @@ int run_sim(int argc, char** argv) {
   for (std::string_view n : sim::scenario_names())
     scenarios += (scenarios.empty() ? "" : ", ") + std::string(n);
   CLI::App app{
-      "Simulates the rig of the config (VLP-32C, A9, D435i colour, PLUG 617 thermal) driving "
+      "Simulates the rig of the config (VLP-32C, A9, D435i colour and optionally depth, PLUG 617 "
+      "thermal) driving "
       "through a scenario and writes a posed recording: the sensors' raw bytes on the channels a "
       "live recording has, stamped with host arrival time, plus the ground truth (base_link in "
       "map) as nav_msgs/Odometry on /posed/ground_truth. Deterministic for a seed.\n"
@@ -103,7 +104,8 @@ int run_sim(int argc, char** argv) {
   std::string scenario = "room", out_path, gt_path, config_path = "config/posed.yaml";
   double duration_s = 60.0;
   std::uint64_t seed = 1;
-  bool no_cameras = false, no_lidar = false, no_noise = false;
+  bool no_cameras = false, no_lidar = false, no_noise = false, depth = false;
+  std::string thermal_format;
   app.add_option("--scenario", scenario, "world and drive: " + scenarios)->capture_default_str();
   app.add_option("--duration", duration_s, "simulated time [s]")
       ->check(CLI::Range(0.1, 86400.0))
@@ -119,6 +121,12 @@ int run_sim(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-cameras", no_cameras, "lidar and IMU only (cameras cost most of the time)");
   app.add_flag("--no-lidar", no_lidar, "no lidar");
+  app.add_flag("--depth", depth,
+               "also the D435i's Z16 depth stream (as config depth_camera.enabled: true)");
+  app.add_option("--thermal-format", thermal_format,
+                 "thermal output: y8 (8-bit video after AGC, as M2DGR) or y16 (raw counts); "
+                 "default: the config's thermal_camera.format")
+      ->check(CLI::IsMember({"y8", "y16"}));
   app.add_flag("--no-noise", no_noise, "ideal sensors: no noise, jitter or dropouts");
   try {
     app.parse(argc, argv);
@@ -131,13 +139,24 @@ int run_sim(int argc, char** argv) {
     std::fprintf(stderr, "posectl sim: %s", loaded.error_text().c_str());
     return 2;
   }
-  const sim::SimRig rig = sim::rig_from_config(loaded.config);
+  sim::SimRig rig = sim::rig_from_config(loaded.config);
+  if (thermal_format.empty()) thermal_format = loaded.config.thermal_camera.format;
+  if (const auto f = sim::thermal_format_from_string(thermal_format)) {
+    rig.thermal_format = *f;
+  } else if (!no_cameras) {
+    std::fprintf(stderr,
+                 "posectl sim: thermal_camera.format %s: the simulator writes y8 or y16 "
+                 "(--thermal-format)\n",
+                 thermal_format.c_str());
+    return 2;
+  }
   sim::SimOptions options;
   options.scenario = scenario;
   options.duration_s = duration_s;
   options.seed = seed;
   options.lidar = !no_lidar;
   options.visible_camera = options.thermal_camera = !no_cameras;
+  options.depth_camera = !no_cameras && (depth || loaded.config.depth_camera.enabled);
   options.noise = !no_noise;
   std::string error;
   {
@@ -194,7 +213,8 @@ int run_sim(int argc, char** argv) {
       "posectl sim: %s seed %llu, %.1f s simulated in %.1f s (%.2fx real time), %llu boxes, "
       "loop %.0f m, driven %.0f m\n"
       "  lidar %llu packets (%llu rays, %.1f %% returns), %llu position packets; imu %llu frames; "
-      "visible %llu frames; thermal %llu frames; ground truth %llu poses\n"
+      "visible %llu frames; thermal %llu frames (%s); depth %llu frames; ground truth %llu "
+      "poses\n"
       "  %s: %llu messages, %.1f MB%s%s\n",
       scenario.c_str(), static_cast<unsigned long long>(seed), duration_s, wall,
       duration_s / std::max(wall, 1e-9), static_cast<unsigned long long>(summary.boxes),
@@ -208,6 +228,8 @@ int run_sim(int argc, char** argv) {
       static_cast<unsigned long long>(summary.imu_frames),
       static_cast<unsigned long long>(summary.visible_frames),
       static_cast<unsigned long long>(summary.thermal_frames),
+      std::string(sim::to_string(rig.thermal_format)).c_str(),
+      static_cast<unsigned long long>(summary.depth_frames),
       static_cast<unsigned long long>(summary.ground_truth_poses), out_path.c_str(),
       static_cast<unsigned long long>(counters.messages_written),
       static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",

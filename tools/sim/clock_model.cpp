@@ -26,4 +26,13 @@ HostTime ClockModel::arrival(Duration t_sent) {
   return HostTime::from_ns(t);
 }
 
+DeviceSchedule::DeviceSchedule(const ClockModel& clock, double rate_hz, Duration phase)
+    : clock_(clock),
+      start_(clock.device_at(Duration::from_ns(0)) + phase),
+      period_ns_(1e9 / rate_hz) {}
+
+DeviceTime DeviceSchedule::device(std::uint64_t k) const {
+  return start_ + Duration::from_ns(std::llround(static_cast<double>(k + 1) * period_ns_));
+}
+
 }  // namespace posed::sim

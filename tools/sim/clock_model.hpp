@@ -49,4 +49,28 @@ class ClockModel {
   std::int64_t last_arrival_ns_ = INT64_MIN;
 };
 
+/// The regular events of a free-running device (IMU samples, camera exposure midpoints), timed
+/// by its own clock: event k (k = 0, 1, ...) at device time start + phase + (k + 1)·period, with
+/// start the device clock at true time 0. Spaced on the device clock, so the host sees the
+/// device's drift in their arrivals.
+class DeviceSchedule {
+ public:
+  DeviceSchedule() = default;
+  /// `rate_hz` on the device's clock; `phase` shifts every event (a stream started later).
+  DeviceSchedule(const ClockModel& clock, double rate_hz, Duration phase = Duration::from_ns(0));
+
+  /// Device time of event k.
+  DeviceTime device(std::uint64_t k) const;
+  /// True time of event k.
+  Duration true_time(std::uint64_t k) const { return clock_.true_at(device(k)); }
+  /// the nominal period [s]
+  double period_s() const { return period_ns_ * 1e-9; }
+  double rate_hz() const { return 1e9 / period_ns_; }
+
+ private:
+  ClockModel clock_;
+  DeviceTime start_;
+  double period_ns_ = 1e9;
+};
+
 }  // namespace posed::sim

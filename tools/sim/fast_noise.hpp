@@ -20,14 +20,18 @@ class FastNoise {
     state_ = seed | 1;
   }
   /// the next N(0, 1) value
-  float normal() {
+  float normal() { return (*table_)[static_cast<std::size_t>(next() >> 48)]; }
+  /// the next U[0, 1) value (24 bits)
+  float uniform() { return static_cast<float>(next() >> 40) * (1.0f / 16777216.0f); }
+
+ private:
+  std::uint64_t next() {
     state_ ^= state_ >> 12;
     state_ ^= state_ << 25;
     state_ ^= state_ >> 27;
-    return (*table_)[static_cast<std::size_t>((state_ * 0x2545F4914F6CDD1Dull) >> 48)];
+    return state_ * 0x2545F4914F6CDD1Dull;
   }
 
- private:
   static constexpr std::size_t kSize = 1u << 16;
   std::unique_ptr<std::array<float, kSize>> table_;
   std::uint64_t state_;

@@ -6,8 +6,7 @@ namespace posed::sim {
 
 ImuModel::ImuModel(const ImuModelConfig& config, const Trajectory& trajectory,
                    const ClockModel& clock, std::uint64_t seed)
-    : config_(config), trajectory_(trajectory), clock_(clock), rng_(seed) {
-  start_device_ = clock_.device_at(Duration::from_ns(0));
+    : config_(config), trajectory_(trajectory), schedule_(clock, config.rate_hz), rng_(seed) {
   if (config_.noise) {
     std::normal_distribution<double> n(0.0, 1.0);
     for (int a = 0; a < 3; ++a) gyro_bias_[a] = config_.gyro_bias_sigma_radps * n(rng_);
@@ -15,16 +14,11 @@ ImuModel::ImuModel(const ImuModelConfig& config, const Trajectory& trajectory,
   }
 }
 
-DeviceTime ImuModel::sample_device(std::uint64_t k) const {
-  const double period_ns = 1e9 / config_.rate_hz;
-  return start_device_ + Duration::from_ns(std::llround(static_cast<double>(k + 1) * period_ns));
-}
-
-Duration ImuModel::next_send() const { return clock_.true_at(sample_device(index_)); }
+Duration ImuModel::next_send() const { return schedule_.true_time(index_); }
 
 std::size_t ImuModel::emit(std::span<std::uint8_t> out) {
-  const DeviceTime d = sample_device(index_);
-  const Duration t = clock_.true_at(d);
+  const DeviceTime d = schedule_.device(index_);
+  const Duration t = schedule_.true_time(index_);
   const TrajectorySample s = trajectory_.at(t);
   Eigen::Vector3d w = s.w_base_radps, f = s.f_base_mps2;
   if (config_.noise) {

@@ -67,13 +67,10 @@ class ImuModel {
   std::uint64_t samples() const { return index_; }
 
  private:
-  DeviceTime sample_device(std::uint64_t k) const;
-
   ImuModelConfig config_;
   const Trajectory& trajectory_;
-  ClockModel clock_;
+  DeviceSchedule schedule_;  // samples regular on the A9's counter
   std::mt19937_64 rng_;
-  DeviceTime start_device_;
   std::uint64_t index_ = 0;
   Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero(), accel_bias_ = Eigen::Vector3d::Zero();
   ImuSampleTruth last_;

@@ -23,14 +23,8 @@ constexpr double kLatitudeDeg = 31.0256, kLongitudeDeg = 121.4337;
 }  // namespace
 
 LidarModel::LidarModel(const LidarModelConfig& config, const vel::Calibration& calibration,
-                       const World& world, const Bvh& bvh, const Trajectory& trajectory,
-                       const ClockModel& clock, std::uint64_t seed)
-    : config_(config),
-      world_(world),
-      bvh_(bvh),
-      trajectory_(trajectory),
-      clock_(clock),
-      rng_(seed) {
+                       const SensorScene& scene, const ClockModel& clock, std::uint64_t seed)
+    : config_(config), scene_(scene), clock_(clock), rng_(seed) {
   const vel::SensorModel& model = *vel::sensor_model(vel::ProductId::kVlp32c);
   distance_resolution_m_ = calibration.distance_resolution_m > 0 ? calibration.distance_resolution_m
                                                                  : model.distance_resolution_m;
@@ -100,7 +94,7 @@ void LidarModel::emit_data(std::span<std::byte> out, LidarPacketTruth* truth) {
     const DeviceTime d = d0 + Duration::from_ns(static_cast<std::int64_t>(f) * period);
     const Duration t_true = clock_.true_at(d);
     if (truth != nullptr) truth->firing_true_ns[f] = t_true.ns;
-    const TrajectorySample s = trajectory_.at(t_true);
+    const TrajectorySample s = scene_.trajectory.at(t_true);
     const Eigen::Matrix3d R_map_base = s.q_map_base.toRotationMatrix();
     const Eigen::Matrix3d R_map_lidar = R_map_base * R_base_lidar;
     const Eigen::Vector3d p_map_lidar = s.p_map_base_m + R_map_base * p_base_lidar;
@@ -122,7 +116,7 @@ void LidarModel::emit_data(std::span<std::byte> out, LidarPacketTruth* truth) {
       dir.normalize();
       const Eigen::Vector3d origin = p_map_lidar + v_map_lidar * dt + R_map_lidar * o_lidar;
       ++rays_;
-      const auto hit = bvh_.cast(origin, dir, config_.max_range_m);
+      const auto hit = scene_.bvh.cast(origin, dir, config_.max_range_m);
       if (truth != nullptr) {
         truth->p_lidar_m[f][c] =
             hit ? Eigen::Vector3f((o_lidar + hit->t_m * d_lidar).cast<float>())
@@ -130,8 +124,8 @@ void LidarModel::emit_data(std::span<std::byte> out, LidarPacketTruth* truth) {
         truth->returned[f][c] = false;
       }
       if (!hit) continue;
-      const Box& box = world_.boxes[hit->box];
-      const Material& m = world_.materials[box.material];
+      const Box& box = scene_.world.boxes[hit->box];
+      const Material& m = scene_.world.materials[box.material];
       const double cos_inc = std::abs(face_normal_map(box, hit->face).dot(dir));
       double range = hit->t_m;
       if (config_.noise) {

@@ -22,10 +22,8 @@
 #include "core/time.hpp"
 #include "drivers/velodyne/calibration.hpp"
 #include "drivers/velodyne/packet_format.hpp"
-#include "tools/sim/bvh.hpp"
 #include "tools/sim/clock_model.hpp"
-#include "tools/sim/trajectory.hpp"
-#include "tools/sim/world.hpp"
+#include "tools/sim/sensor_scene.hpp"
 
 namespace posed::sim {
 
@@ -63,8 +61,7 @@ struct LidarPacketTruth {
 class LidarModel {
  public:
   LidarModel(const LidarModelConfig& config, const drivers::velodyne::Calibration& calibration,
-             const World& world, const Bvh& bvh, const Trajectory& trajectory,
-             const ClockModel& clock, std::uint64_t seed);
+             const SensorScene& scene, const ClockModel& clock, std::uint64_t seed);
 
   /// True time at which the next data packet is complete and sent.
   Duration next_data_send() const;
@@ -89,9 +86,7 @@ class LidarModel {
   DeviceTime first_firing(std::uint64_t packet) const;
 
   LidarModelConfig config_;
-  const World& world_;
-  const Bvh& bvh_;
-  const Trajectory& trajectory_;
+  SensorScene scene_;
   ClockModel clock_;
   std::mt19937_64 rng_;
   std::array<Channel, 32> channels_{};

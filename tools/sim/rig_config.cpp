@@ -16,6 +16,7 @@ SimRig rig_from_config(const config::PosedConfig& cfg) {
   rig.T_imu_lidar = pipeline::to_isometry(cfg.extrinsics.T_imu_lidar);
   rig.T_imu_cam = pipeline::to_isometry(cfg.extrinsics.T_imu_cam);
   rig.T_cam_thermal = pipeline::to_isometry(cfg.extrinsics.T_cam_thermal);
+  rig.T_cam_depth = pipeline::to_isometry(cfg.extrinsics.T_cam_depth);
   rig.imu.rate_hz = cfg.imu.rate_hz;
   rig.imu.gyro_noise_density = cfg.imu.gyro_noise_density;
   rig.imu.gyro_random_walk = cfg.imu.gyro_random_walk;
@@ -30,8 +31,19 @@ SimRig rig_from_config(const config::PosedConfig& cfg) {
   rig.visible_rate_hz = cfg.visible_camera.rate_hz;
   rig.thermal = to_intrinsics(cfg.thermal_camera);
   rig.thermal_rate_hz = cfg.thermal_camera.rate_hz;
+  // Formats other than the two the simulator writes (yuyv, mjpeg) leave the default y8; the
+  // caller says so (posectl sim refuses them).
+  rig.thermal_format =
+      thermal_format_from_string(cfg.thermal_camera.format).value_or(ThermalFormat::kY8);
   rig.thermal_latency_s = cfg.thermal_camera.latency_s;
   rig.visible_latency_s = cfg.visible_camera.latency_s;
+  const config::DepthCameraSection& d = cfg.depth_camera;
+  rig.depth.intrinsics = {d.width, d.height, d.fx, d.fy, d.cx, d.cy, 0, 0, 0, 0};
+  rig.depth.rate_hz = d.rate_hz;
+  rig.depth.baseline_m = d.baseline_m;
+  rig.depth.depth_unit_m = d.depth_unit_m;
+  rig.depth.min_range_m = d.min_range_m;
+  rig.depth.max_range_m = d.max_range_m;
   return rig;
 }
 

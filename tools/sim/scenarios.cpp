@@ -102,15 +102,53 @@ void add_ground(World& w, std::uint32_t material) {
   w.add_aabb({-600, -600, -0.3}, {600, 600, 0}, material);
 }
 
-Scenario room(std::uint64_t seed, double duration_s, double g) {
-  Rng rng(seed * 0x9E3779B97F4A7C15ull + 1);
+/// A scenario's light and temperatures (World's fields of the same names).
+struct Environment {
+  double ambient = 0, headlight = 0, sky_radiance = 0;
+  double air_temperature_c = 15, sky_temperature_c = -20;
+};
+
+/// How a scenario drives: a standing start, then holds and ramps between random speeds with
+/// stops, and bumps (at full speed) in height, roll and pitch.
+struct DriveStyle {
+  double v_min_mps = 0, v_max_mps = 0, accel_mps2 = 0, stop_probability = 0;
+  double bump_z_m = 0, bump_angle_rad = 0;
+  double static_s = 2.0;
+};
+
+/// An empty scenario with its own random stream: the world's environment set, nothing in it.
+/// `salt` keeps the scenarios' streams apart for one seed.
+Scenario begin_scenario(std::string name, std::uint64_t seed, std::uint64_t salt,
+                        const Environment& env, Rng& rng) {
+  rng.seed(seed * 0x9E3779B97F4A7C15ull + salt);
   Scenario s;
-  s.name = "room";
+  s.name = std::move(name);
+  s.world.ambient = env.ambient;
+  s.world.headlight = env.headlight;
+  s.world.sky_radiance = env.sky_radiance;
+  s.world.air_temperature_c = env.air_temperature_c;
+  s.world.sky_temperature_c = env.sky_temperature_c;
+  return s;
+}
+
+/// The drive along `path` in `style`, covering `duration_s`. Draws the bumps, then the speeds:
+/// the order in which the scenarios' drives have always been drawn for a seed (the arguments of
+/// one Trajectory(...) call, which GCC evaluates right to left).
+Trajectory drive(Rng& rng, const PeriodicSpline2& path, const DriveStyle& style, double duration_s,
+                 double gravity) {
+  TrajectoryConfig bumps = make_bumps(rng, style.bump_z_m, style.bump_angle_rad, gravity);
+  SpeedProfile speed = make_speed(rng, duration_s, style.static_s, style.v_min_mps, style.v_max_mps,
+                                  style.accel_mps2, style.stop_probability);
+  return Trajectory(path, std::move(speed), std::move(bumps));
+}
+
+Scenario room(std::uint64_t seed, double duration_s, double g) {
+  // No sky indoors: rays that escape see a ceiling-like temperature.
+  Rng rng;
+  Scenario s = begin_scenario(
+      "room", seed, 1,
+      {.ambient = 0.6, .sky_radiance = 0.3, .air_temperature_c = 22, .sky_temperature_c = 21}, rng);
   World& w = s.world;
-  w.ambient = 0.6;
-  w.sky_radiance = 0.3;
-  w.air_temperature_c = 22;
-  w.sky_temperature_c = 21;  // no sky indoors; rays that escape see a ceiling-like temperature
   const auto floor = w.add_material({35, 0.45, kTextureNoise, 0.35, 21, 0, {0.7, 0.8, 0.9}});
   const auto wall = w.add_material({60, 0.75, kTextureNoise, 0.1, 22, 0, {0.9, 0.95, 1.0}});
   const auto poster = w.add_material({45, 0.6, kTextureChecker, 0.8, 22, 0, {1, 1, 1}});
@@ -155,20 +193,23 @@ Scenario room(std::uint64_t seed, double duration_s, double g) {
       w.lights.push_back({{x, y, h - 0.1}, 1.5});
     }
   PeriodicSpline2 path(loop_waypoints(rng, 8, hx - 1.7, hy - 1.5, 0.12));
-  s.trajectory = Trajectory(path, make_speed(rng, duration_s, 2.0, 0.3, 0.8, 0.4, 0.15),
-                            make_bumps(rng, 0.002, 0.003, g));
+  s.trajectory = drive(rng, path,
+                       {.v_min_mps = 0.3,
+                        .v_max_mps = 0.8,
+                        .accel_mps2 = 0.4,
+                        .stop_probability = 0.15,
+                        .bump_z_m = 0.002,
+                        .bump_angle_rad = 0.003},
+                       duration_s, g);
   return s;
 }
 
 Scenario corridor(std::uint64_t seed, double duration_s, double g) {
-  Rng rng(seed * 0x9E3779B97F4A7C15ull + 2);
-  Scenario s;
-  s.name = "corridor";
+  Rng rng;
+  Scenario s = begin_scenario(
+      "corridor", seed, 2,
+      {.ambient = 0.02, .headlight = 0.6, .air_temperature_c = 20, .sky_temperature_c = 20}, rng);
   World& w = s.world;
-  w.ambient = 0.02;
-  w.headlight = 0.6;
-  w.air_temperature_c = 20;
-  w.sky_temperature_c = 20;
   const auto floor = w.add_material({30, 0.35, kTextureNoise, 0.08, 20, 0, {0.8, 0.85, 0.9}});
   const auto wall = w.add_material({55, 0.7, kTexturePlain, 0, 20.5, 0, {0.85, 0.95, 1.0}});
   const auto end_wall = w.add_material({5, 0.1, kTexturePlain, 0, 20, 0, {1, 1, 1}});
@@ -206,21 +247,23 @@ Scenario corridor(std::uint64_t seed, double duration_s, double g) {
     const double a = kPi / 2 + kPi * k / 6;
     pts.emplace_back(-run + turn * std::cos(a), turn * std::sin(a));
   }
-  s.trajectory =
-      Trajectory(PeriodicSpline2(pts), make_speed(rng, duration_s, 2.0, 0.6, 1.4, 0.4, 0.1),
-                 make_bumps(rng, 0.003, 0.004, g));
+  s.trajectory = drive(rng, PeriodicSpline2(pts),
+                       {.v_min_mps = 0.6,
+                        .v_max_mps = 1.4,
+                        .accel_mps2 = 0.4,
+                        .stop_probability = 0.1,
+                        .bump_z_m = 0.003,
+                        .bump_angle_rad = 0.004},
+                       duration_s, g);
   return s;
 }
 
 Scenario mine(std::uint64_t seed, double duration_s, double g) {
-  Rng rng(seed * 0x9E3779B97F4A7C15ull + 3);
-  Scenario s;
-  s.name = "mine";
+  Rng rng;
+  Scenario s = begin_scenario(
+      "mine", seed, 3,
+      {.ambient = 0.003, .headlight = 1.0, .air_temperature_c = 17, .sky_temperature_c = 17}, rng);
   World& w = s.world;
-  w.ambient = 0.003;
-  w.headlight = 1.0;
-  w.air_temperature_c = 17;
-  w.sky_temperature_c = 17;
   const auto ground = w.add_material({15, 0.2, kTextureNoise, 0.3, 16, 0, {0.6, 0.65, 0.7}});
   const auto rock = w.add_material({22, 0.25, kTextureNoise, 0.25, 17, 0, {0.6, 0.7, 0.75}});
   const auto machine = w.add_material({35, 0.35, kTextureStripes, 0.5, 55, 0, {0.2, 0.6, 0.9}});
@@ -256,21 +299,27 @@ Scenario mine(std::uint64_t seed, double duration_s, double g) {
       w.lights.push_back({{f.p.x(), f.p.y(), roof - 0.2}, 0.3});
     }
   }
-  s.trajectory = Trajectory(path, make_speed(rng, duration_s, 2.0, 0.5, 1.5, 0.5, 0.15),
-                            make_bumps(rng, 0.02, 0.02, g));
+  s.trajectory = drive(rng, path,
+                       {.v_min_mps = 0.5,
+                        .v_max_mps = 1.5,
+                        .accel_mps2 = 0.5,
+                        .stop_probability = 0.15,
+                        .bump_z_m = 0.02,
+                        .bump_angle_rad = 0.02},
+                       duration_s, g);
   return s;
 }
 
 Scenario street_night(std::uint64_t seed, double duration_s, double g) {
-  Rng rng(seed * 0x9E3779B97F4A7C15ull + 4);
-  Scenario s;
-  s.name = "street_night";
+  Rng rng;
+  Scenario s = begin_scenario("street_night", seed, 4,
+                              {.ambient = 0.01,
+                               .headlight = 0.8,
+                               .sky_radiance = 0.02,
+                               .air_temperature_c = 12,
+                               .sky_temperature_c = -30},
+                              rng);
   World& w = s.world;
-  w.ambient = 0.01;
-  w.headlight = 0.8;
-  w.air_temperature_c = 12;
-  w.sky_temperature_c = -30;
-  w.sky_radiance = 0.02;
   const auto asphalt = w.add_material({12, 0.12, kTextureNoise, 0.3, 16, 0, {0.8, 0.8, 0.8}});
   const auto brick = w.add_material({30, 0.35, kTextureBricks, 0.6, 13, 0, {0.4, 0.5, 0.75}});
   const auto concrete = w.add_material({40, 0.5, kTextureNoise, 0.3, 14, 0, {0.85, 0.85, 0.85}});
@@ -328,8 +377,14 @@ Scenario street_night(std::uint64_t seed, double duration_s, double g) {
       w.add_yawed({c.x(), c.y(), 0.85}, {0.25, 0.2, 0.85}, f.yaw, person);
     }
   }
-  s.trajectory = Trajectory(path, make_speed(rng, duration_s, 2.0, 2.0, 6.0, 0.8, 0.12),
-                            make_bumps(rng, 0.008, 0.006, g));
+  s.trajectory = drive(rng, path,
+                       {.v_min_mps = 2.0,
+                        .v_max_mps = 6.0,
+                        .accel_mps2 = 0.8,
+                        .stop_probability = 0.12,
+                        .bump_z_m = 0.008,
+                        .bump_angle_rad = 0.006},
+                       duration_s, g);
   return s;
 }
 

@@ -20,9 +20,10 @@
 namespace posed::sim {
 
 struct SimStream {
-  /// Source name ("imu", "lidar", "visible", "thermal")
+  /// Source name ("imu", "lidar", "visible", "thermal", "depth")
   std::string name;
-  /// how to decode the bytes (raw_channels.hpp kWire*, or a camera format "yuyv" / "y8")
+  /// how to decode the bytes (raw_channels.hpp kWire*, or a camera pixel format: "yuyv", "y8",
+  /// "y16", "z16")
   std::string wire_format;
   /// the Source channel (lidar: 0 = data port, 1 = position port)
   std::uint32_t source_channel = 0;

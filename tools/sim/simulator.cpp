@@ -1,7 +1,6 @@
 #include "tools/sim/simulator.hpp"
 
 #include <cmath>
-#include <memory>
 #include <optional>
 #include <queue>
 #include <random>
@@ -14,6 +13,7 @@
 #include "tools/sim/d4xx_metadata_encoder.hpp"
 #include "tools/sim/lidar_model.hpp"
 #include "tools/sim/scenarios.hpp"
+#include "tools/sim/visible_camera.hpp"
 
 namespace posed::sim {
 namespace {
@@ -32,6 +32,42 @@ struct Pending {
   }
 };
 
+/// Everything generated but not yet written, released in host-arrival order.
+class ArrivalQueue {
+ public:
+  void push(std::int64_t host_ns, int stream, std::vector<std::byte> bytes) {
+    Pending p;
+    p.host_ns = host_ns;
+    p.seq = seq_++;
+    p.stream = stream;
+    p.bytes = std::move(bytes);
+    queue_.push(std::move(p));
+  }
+  void push_pose(std::int64_t host_ns, const GroundTruthPose& pose) {
+    Pending p;
+    p.host_ns = host_ns;
+    p.seq = seq_++;
+    p.pose = pose;
+    queue_.push(std::move(p));
+  }
+  /// Writes everything that arrives before `host_ns`; false when the sink fails.
+  bool flush_until(std::int64_t host_ns, SimSink& sink) {
+    while (!queue_.empty() && queue_.top().host_ns < host_ns) {
+      const Pending& p = queue_.top();
+      const bool ok = p.stream < 0
+                          ? sink.write_ground_truth(HostTime::from_ns(p.host_ns), p.pose)
+                          : sink.write_raw(p.stream, HostTime::from_ns(p.host_ns), p.bytes);
+      if (!ok) return false;
+      queue_.pop();
+    }
+    return true;
+  }
+
+ private:
+  std::priority_queue<Pending, std::vector<Pending>, std::greater<>> queue_;
+  std::uint64_t seq_ = 0;
+};
+
 std::string num(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.9g", v);
@@ -44,30 +80,6 @@ std::map<std::string, std::string> clock_metadata(const ClockModelConfig& c, boo
           {"sim.clock_drift_ppm", num(c.drift_ppm)},
           {"sim.latency_ns", std::to_string(c.latency_ns)},
           {"sim.jitter_mean_ns", std::to_string(c.jitter_mean_ns)}};
-}
-
-/// What the D435i reports about the next visible frame. Its auto-exposure is modelled as one
-/// amplification (VisibleCamera::gain); reported as the real one splits it: exposure first, up
-/// to half the frame interval, then analog gain (64 = 1x).
-D4xxFrameFacts visible_metadata(const VisibleCamera& camera, const SimRig& rig, HostTime arrival) {
-  D4xxFrameFacts f;
-  const double interval_us = 1e6 / rig.visible_rate_hz;
-  const double max_exposure_us = interval_us / 2;
-  const double exposure_us = max_exposure_us * std::min(camera.gain(), 1.0);
-  const std::int64_t mid_us = camera.next_exposure_mid().ns / 1000;
-  f.frame_counter = static_cast<std::uint32_t>(camera.frames());
-  f.sensor_timestamp_us = static_cast<std::uint32_t>(mid_us);  // the device counter wraps
-  f.pts_us = static_cast<std::uint32_t>(mid_us - std::llround(exposure_us / 2));
-  f.exposure_time_us = static_cast<std::uint32_t>(std::llround(exposure_us));
-  f.frame_interval_us = static_cast<std::uint32_t>(std::llround(interval_us));
-  f.gain = static_cast<std::uint32_t>(std::llround(64 * std::max(camera.gain(), 1.0)));
-  f.width_px = static_cast<std::uint16_t>(rig.visible.width);
-  f.height_px = static_cast<std::uint16_t>(rig.visible.height);
-  f.fps = static_cast<std::uint16_t>(std::lround(rig.visible_rate_hz));
-  // uvc_meta_buf.ns: the frame's first USB packet, about half a frame interval before the last.
-  f.host_sof_ns = static_cast<std::uint64_t>(arrival.ns - std::llround(interval_us * 500));
-  f.usb_sof = static_cast<std::uint16_t>((f.host_sof_ns / 1'000'000) & 0x7FF);
-  return f;
 }
 
 /// Per-device clocks for a seed (offsets, drifts tens of ppm) and transports.
@@ -97,6 +109,19 @@ Clocks make_clocks(std::mt19937_64& rng, const SimRig& rig, bool noise) {
   return c;
 }
 
+/// A camera frame and, for the D435i's nodes, the metadata buffer the V4L2 Source delivers
+/// just before it (it completes with the frame and is read first).
+template <class D4xxCamera>
+std::vector<std::byte> d4xx_frame(D4xxCamera& camera, HostTime arrival, int metadata_stream,
+                                  ArrivalQueue& queue) {
+  std::vector<std::byte> metadata;
+  encode_d4xx_metadata(camera.next_metadata(arrival), metadata);
+  queue.push(arrival.ns, metadata_stream, std::move(metadata));
+  std::vector<std::byte> frame;
+  camera.emit(frame);
+  return frame;
+}
+
 }  // namespace
 
 bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
@@ -108,15 +133,16 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
   std::optional<Scenario> scenario =
       make_scenario(options.scenario, options.seed, options.duration_s, rig.gravity_mps2, error);
   if (!scenario) return false;
-  const World& world = scenario->world;
   const Trajectory& trajectory = scenario->trajectory;
-  const Bvh bvh(world);
+  const Bvh bvh(scenario->world);
+  const SensorScene scene{scenario->world, bvh, trajectory};
   summary = {};
-  summary.boxes = world.boxes.size();
+  summary.boxes = scenario->world.boxes.size();
   summary.path_length_m = trajectory.path().length();
   summary.host_to_wall_ns = kSimWallStartNs - options.host_epoch_ns;
 
-  // Independent RNG streams per device, all derived from the seed.
+  // Independent RNG streams per device, all derived from the seed. The depth camera draws last,
+  // so turning it on leaves every other stream's bytes as they were.
   std::mt19937_64 seeder(options.seed ^ 0x5EEDC0FFEEull);
   const Clocks clocks = make_clocks(seeder, rig, options.noise);
   const std::int64_t epoch = options.host_epoch_ns;
@@ -133,7 +159,7 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
   lidar_cfg.noise = options.noise;
   ClockModel lidar_clock(clocks.lidar, epoch, next_seed());
   ClockModel position_clock(clocks.lidar, epoch, next_seed());
-  LidarModel lidar(lidar_cfg, calibration, world, bvh, trajectory, lidar_clock, next_seed());
+  LidarModel lidar(lidar_cfg, calibration, scene, lidar_clock, next_seed());
 
   ImuModelConfig imu_cfg = rig.imu;
   imu_cfg.noise = options.noise;
@@ -146,33 +172,38 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
   vis_cfg.rate_hz = rig.visible_rate_hz;
   vis_cfg.noise = options.noise;
   ClockModel vis_clock(clocks.visible, epoch, next_seed());
-  VisibleCamera visible(vis_cfg, world, bvh, trajectory, vis_clock, next_seed());
+  VisibleCamera visible(vis_cfg, scene, vis_clock, next_seed());
 
   ThermalCameraConfig th_cfg;
   th_cfg.intrinsics = rig.thermal;
   th_cfg.T_base_cam = rig.T_imu_cam * rig.T_cam_thermal;
   th_cfg.rate_hz = rig.thermal_rate_hz;
+  th_cfg.format = rig.thermal_format;
   th_cfg.noise = options.noise;
   ClockModel th_clock(clocks.thermal, epoch, next_seed());
-  ThermalCamera thermal(th_cfg, world, bvh, trajectory, th_clock, next_seed());
+  ThermalCamera thermal(th_cfg, scene, th_clock, next_seed());
+
+  // The depth node runs on the D435i's clock (the colour node's) with its own transport jitter
+  // and a frame phase of its own: the two nodes stream independently.
+  DepthCameraConfig depth_cfg = rig.depth;
+  depth_cfg.T_base_depth = rig.T_imu_cam * rig.T_cam_depth;
+  depth_cfg.noise = options.noise;
+  ClockModel depth_clock(clocks.visible, epoch, next_seed());
+  const auto depth_phase = Duration::from_seconds(
+      std::uniform_real_distribution<double>(0, 1.0 / depth_cfg.rate_hz)(seeder));
+  DepthCamera depth(depth_cfg, scene, depth_clock, next_seed(), depth_phase);
 
   // Streams, named as the daemon's Sources name them (raw_channels.hpp).
   const std::string scen = "sim " + options.scenario + " seed " + std::to_string(options.seed);
   int s_imu = -1, s_lidar = -1, s_pos = -1, s_vis = -1, s_vis_meta = -1, s_th = -1;
-  if (options.imu) {
-    auto md = clock_metadata(clocks.imu, true);
-    md["rate_hz"] = num(rig.imu.rate_hz);
-    md["device"] = scen;
-    s_imu = sink.add_stream({"imu", std::string(raw::kWireA9Serial), 0, md});
-  }
-  if (options.lidar) {
-    auto md = clock_metadata(clocks.lidar, true);
-    md["rpm"] = num(rig.lidar_rpm);
-    md["calibration"] = calibration.source;
-    md["device"] = scen;
-    s_lidar = sink.add_stream({"lidar", std::string(raw::kWireVelodyneData), 0, md});
-    s_pos = sink.add_stream({"lidar", std::string(raw::kWireVelodynePosition), 1, md});
-  }
+  int s_depth = -1, s_depth_meta = -1;
+  bool refused = false;
+  auto add = [&](const char* name, std::string_view wire, std::uint32_t channel,
+                 const std::map<std::string, std::string>& md) {
+    const int id = sink.add_stream({name, std::string(wire), channel, md});
+    refused = refused || id < 0;
+    return id;
+  };
   auto camera_md = [&](const CameraIntrinsics& K, double rate, const ClockModelConfig& c,
                        bool clock) {
     auto md = clock_metadata(c, clock);
@@ -182,42 +213,51 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
     md["device"] = scen;
     return md;
   };
+  if (options.imu) {
+    auto md = clock_metadata(clocks.imu, true);
+    md["rate_hz"] = num(rig.imu.rate_hz);
+    md["device"] = scen;
+    s_imu = add("imu", raw::kWireA9Serial, 0, md);
+  }
+  if (options.lidar) {
+    auto md = clock_metadata(clocks.lidar, true);
+    md["rpm"] = num(rig.lidar_rpm);
+    md["calibration"] = calibration.source;
+    md["device"] = scen;
+    s_lidar = add("lidar", raw::kWireVelodyneData, 0, md);
+    s_pos = add("lidar", raw::kWireVelodynePosition, 1, md);
+  }
   if (options.visible_camera) {
     const auto md = camera_md(rig.visible, rig.visible_rate_hz, clocks.visible, true);
-    s_vis = sink.add_stream({"visible", "yuyv", 0, md});
+    s_vis = add("visible", "yuyv", 0, md);
     // The D435i's frame metadata, on the Source channel the V4L2 Source gives it.
-    s_vis_meta = sink.add_stream({"visible", std::string(drivers::wire::kUvcMetaD4xx), 1, md});
+    s_vis_meta = add("visible", drivers::wire::kUvcMetaD4xx, 1, md);
   }
-  if (options.thermal_camera)
-    s_th = sink.add_stream(
-        {"thermal", "y8", 0, camera_md(rig.thermal, rig.thermal_rate_hz, clocks.thermal, false)});
-  if ((options.imu && s_imu < 0) || (options.lidar && (s_lidar < 0 || s_pos < 0)) ||
-      (options.visible_camera && (s_vis < 0 || s_vis_meta < 0)) ||
-      (options.thermal_camera && s_th < 0)) {
+  if (options.thermal_camera) {
+    s_th = add("thermal", to_string(rig.thermal_format), 0,
+               camera_md(rig.thermal, rig.thermal_rate_hz, clocks.thermal, false));
+  }
+  if (options.depth_camera) {
+    auto md = camera_md(depth_cfg.intrinsics, depth_cfg.rate_hz, clocks.visible, true);
+    md["depth_unit_m"] = num(depth_cfg.depth_unit_m);
+    md["baseline_m"] = num(depth_cfg.baseline_m);
+    s_depth = add("depth", "z16", 0, md);
+    s_depth_meta = add("depth", drivers::wire::kUvcMetaD4xx, 1, md);
+  }
+  if (refused) {
     error = "the sink refused a stream";
     return false;
   }
 
-  std::priority_queue<Pending, std::vector<Pending>, std::greater<>> pending;
-  std::uint64_t seq = 0;
-  auto push = [&](std::int64_t host_ns, int stream, std::vector<std::byte> bytes) {
-    Pending p;
-    p.host_ns = host_ns;
-    p.seq = seq++;
-    p.stream = stream;
-    p.bytes = std::move(bytes);
-    pending.push(std::move(p));
-  };
-  auto flush_until = [&](std::int64_t host_ns) {
-    while (!pending.empty() && pending.top().host_ns < host_ns) {
-      const Pending& p = pending.top();
-      const bool ok = p.stream < 0
-                          ? sink.write_ground_truth(HostTime::from_ns(p.host_ns), p.pose)
-                          : sink.write_raw(p.stream, HostTime::from_ns(p.host_ns), p.bytes);
-      if (!ok) return false;
-      pending.pop();
+  ArrivalQueue queue;
+  // Sends everything a device completes before `w1`, stamped with its host arrival.
+  auto drain = [&](Duration w1, ClockModel& clock, int stream, std::uint64_t& count,
+                   auto&& next_send, auto&& bytes_arriving_at) {
+    while (next_send() < w1) {
+      const HostTime arrival = clock.arrival(next_send());
+      queue.push(arrival.ns, stream, bytes_arriving_at(arrival));
+      ++count;
     }
-    return true;
   };
 
   const Duration end = Duration::from_seconds(options.duration_s);
@@ -234,66 +274,60 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
     // can arrive before host(w1) any more and those messages can go out in order.
     while (next_gt < w1) {
       const TrajectorySample s = trajectory.at(next_gt);
-      Pending p;
-      p.host_ns = epoch + next_gt.ns;
-      p.seq = seq++;
-      p.pose = {s.p_map_base_m, s.q_map_base, s.v_map_mps, s.w_base_radps};
+      queue.push_pose(epoch + next_gt.ns,
+                      {s.p_map_base_m, s.q_map_base, s.v_map_mps, s.w_base_radps});
       summary.distance_m += (s.p_map_base_m - last_p).norm();
       last_p = s.p_map_base_m;
-      pending.push(std::move(p));
       ++summary.ground_truth_poses;
       next_gt = Duration::from_ns(std::llround(static_cast<double>(summary.ground_truth_poses) *
                                                static_cast<double>(gt_period.ns)));
     }
     if (options.imu) {
-      while (imu.next_send() < w1) {
-        const Duration sent = imu.next_send();
-        const std::size_t n = imu.emit(imu_buf);
-        const auto* b = reinterpret_cast<const std::byte*>(imu_buf.data());
-        push(imu_clock.arrival(sent).ns, s_imu, std::vector<std::byte>(b, b + n));
-        ++summary.imu_frames;
-      }
+      drain(
+          w1, imu_clock, s_imu, summary.imu_frames, [&] { return imu.next_send(); },
+          [&](HostTime) {
+            const std::size_t n = imu.emit(imu_buf);
+            const auto* b = reinterpret_cast<const std::byte*>(imu_buf.data());
+            return std::vector<std::byte>(b, b + n);
+          });
     }
     if (options.lidar) {
-      while (lidar.next_data_send() < w1) {
-        const Duration sent = lidar.next_data_send();
-        std::vector<std::byte> bytes(drivers::velodyne::kDataPacketBytes);
-        lidar.emit_data(bytes);
-        push(lidar_clock.arrival(sent).ns, s_lidar, std::move(bytes));
-        ++summary.lidar_packets;
-      }
-      while (lidar.next_position_send() < w1) {
-        const Duration sent = lidar.next_position_send();
-        std::vector<std::byte> bytes(drivers::velodyne::kPositionPacketBytes);
-        lidar.emit_position(bytes);
-        push(position_clock.arrival(sent).ns, s_pos, std::move(bytes));
-        ++summary.position_packets;
-      }
+      drain(
+          w1, lidar_clock, s_lidar, summary.lidar_packets, [&] { return lidar.next_data_send(); },
+          [&](HostTime) {
+            std::vector<std::byte> bytes(drivers::velodyne::kDataPacketBytes);
+            lidar.emit_data(bytes);
+            return bytes;
+          });
+      drain(
+          w1, position_clock, s_pos, summary.position_packets,
+          [&] { return lidar.next_position_send(); },
+          [&](HostTime) {
+            std::vector<std::byte> bytes(drivers::velodyne::kPositionPacketBytes);
+            lidar.emit_position(bytes);
+            return bytes;
+          });
     }
     if (options.visible_camera) {
-      while (visible.next_send() < w1) {
-        const Duration sent = visible.next_send();
-        // The metadata buffer completes with the frame and is read just before it.
-        const HostTime arrival = vis_clock.arrival(sent);
-        std::vector<std::byte> metadata;
-        encode_d4xx_metadata(visible_metadata(visible, rig, arrival), metadata);
-        push(arrival.ns, s_vis_meta, std::move(metadata));
-        std::vector<std::byte> bytes;
-        visible.emit(bytes);
-        push(arrival.ns, s_vis, std::move(bytes));
-        ++summary.visible_frames;
-      }
+      drain(
+          w1, vis_clock, s_vis, summary.visible_frames, [&] { return visible.next_send(); },
+          [&](HostTime arrival) { return d4xx_frame(visible, arrival, s_vis_meta, queue); });
     }
     if (options.thermal_camera) {
-      while (thermal.next_send() < w1) {
-        const Duration sent = thermal.next_send();
-        std::vector<std::byte> bytes;
-        thermal.emit(bytes);
-        push(th_clock.arrival(sent).ns, s_th, std::move(bytes));
-        ++summary.thermal_frames;
-      }
+      drain(
+          w1, th_clock, s_th, summary.thermal_frames, [&] { return thermal.next_send(); },
+          [&](HostTime) {
+            std::vector<std::byte> bytes;
+            thermal.emit(bytes);
+            return bytes;
+          });
     }
-    if (!flush_until(epoch + w1.ns)) {
+    if (options.depth_camera) {
+      drain(
+          w1, depth_clock, s_depth, summary.depth_frames, [&] { return depth.next_send(); },
+          [&](HostTime arrival) { return d4xx_frame(depth, arrival, s_depth_meta, queue); });
+    }
+    if (!queue.flush_until(epoch + w1.ns, sink)) {
       error = "the sink failed to write";
       return false;
     }
@@ -302,7 +336,7 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
       if (!progress(w1.seconds())) break;
     }
   }
-  if (!flush_until(INT64_MAX)) {
+  if (!queue.flush_until(INT64_MAX, sink)) {
     error = "the sink failed to write";
     return false;
   }

@@ -8,7 +8,8 @@
 //                   would stamp on arrival), the base of the ground truth
 //   device clocks   per device: offset + drift (ClockModel); the lidar's counts from
 //                   2024-06-01T00:00:00Z (GPRMC), the A9's from power-on, the D435i's hardware
-//                   clock from power-on; the thermal camera has none
+//                   clock from power-on (colour and depth: one ASIC stamps both); the thermal
+//                   camera has none
 
 #include <cstdint>
 #include <functional>
@@ -16,9 +17,11 @@
 
 #include "drivers/imu/a9_protocol.hpp"
 #include "drivers/velodyne/calibration.hpp"
-#include "tools/sim/camera_model.hpp"
+#include "tools/sim/depth_camera.hpp"
+#include "tools/sim/gbuffer.hpp"
 #include "tools/sim/imu_model.hpp"
 #include "tools/sim/sim_sink.hpp"
+#include "tools/sim/thermal_camera.hpp"
 
 namespace posed::sim {
 
@@ -41,13 +44,19 @@ struct SimRig {
   /// colour camera: 640x480 at 15 Hz in M2DGR
   CameraIntrinsics visible;
   double visible_rate_hz = 15.0;
-  /// thermal camera: 640x512 at 25 Hz
+  /// thermal camera: 640x512 at 25 Hz, 8-bit video or 16-bit raw counts
   CameraIntrinsics thermal;
   double thermal_rate_hz = 25.0;
+  ThermalFormat thermal_format = ThermalFormat::kY8;
   /// host arrival minus exposure for the clockless thermal camera [s]
   double thermal_latency_s = 0.03;
   /// least host arrival minus exposure midpoint of a colour frame: readout plus USB [s]
   double visible_latency_s = 0.041;
+  /// the D435i's depth node: intrinsics, rate, baseline, depth units, working range and error
+  /// model (its T_base_depth is ignored: the depth frame is T_imu_cam · T_cam_depth)
+  DepthCameraConfig depth;
+  /// depth (left IR) imager in the colour camera frame
+  Eigen::Isometry3d T_cam_depth = Eigen::Isometry3d::Identity();
 };
 
 struct SimOptions {
@@ -59,6 +68,8 @@ struct SimOptions {
   bool imu = true;
   bool visible_camera = true;
   bool thermal_camera = true;
+  /// the D435i's depth stream (M2DGR has none, so off unless asked for)
+  bool depth_camera = false;
   /// false: ideal sensors (no noise, no jitter, no dropouts); geometry stays the same
   bool noise = true;
   /// ground-truth pose rate [Hz]
@@ -69,7 +80,7 @@ struct SimOptions {
 
 struct SimSummary {
   std::uint64_t lidar_packets = 0, position_packets = 0, imu_frames = 0;
-  std::uint64_t visible_frames = 0, thermal_frames = 0, ground_truth_poses = 0;
+  std::uint64_t visible_frames = 0, thermal_frames = 0, depth_frames = 0, ground_truth_poses = 0;
   /// lidar rays cast / returns encoded
   std::uint64_t lidar_rays = 0, lidar_returns = 0;
   /// world size

@@ -112,6 +112,11 @@ class Trajectory {
   /// State at `t_s` seconds after the start (true time).
   TrajectorySample at(double t_s) const;
   TrajectorySample at(Duration t) const { return at(t.seconds()); }
+  /// base_link in map at `t` (a sensor's pose: T_map_base(t) * T_base_sensor).
+  Eigen::Isometry3d T_map_base(Duration t) const {
+    const TrajectorySample s = at(t);
+    return Eigen::Translation3d(s.p_map_base_m) * s.q_map_base;
+  }
 
   const PeriodicSpline2& path() const { return path_; }
   const SpeedProfile& speed() const { return speed_; }

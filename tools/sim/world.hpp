@@ -6,8 +6,12 @@
 // Frame `map`: x east, y north, z up; ground at z = 0.
 
 #include <Eigen/Core>
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace posed::sim {
@@ -95,13 +99,61 @@ struct RayHit {
   std::uint8_t face = 0;
 };
 
-/// Ray-box intersection in the box frame (slab test). `t_max_m` bounds the search.
+/// Slab test of a ray given in a box's own frame: origin `o` [m], unit direction `d` and its
+/// reciprocal `inv_d` in box axes, against half extents `half_m` [m]. `t_max_m` bounds the
+/// search. The entry hit (or the exit hit if the origin is inside the box), `box` left 0.
+/// Inline: the BVH runs it for every box a ray reaches.
+inline std::optional<RayHit> slab_hit(const std::array<double, 3>& o,
+                                      const std::array<double, 3>& d,
+                                      const std::array<double, 3>& inv_d,
+                                      const std::array<double, 3>& half_m, double t_max_m) {
+  double t_near = -std::numeric_limits<double>::infinity();
+  double t_far = std::numeric_limits<double>::infinity();
+  std::size_t near_axis = 0, far_axis = 0;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double h = half_m[a];
+    if (std::abs(d[a]) < 1e-15) {
+      if (o[a] < -h || o[a] > h) return std::nullopt;  // parallel and outside the slab
+      continue;
+    }
+    double t0 = (-h - o[a]) * inv_d[a], t1 = (h - o[a]) * inv_d[a];
+    if (t0 > t1) std::swap(t0, t1);
+    if (t0 > t_near) {
+      t_near = t0;
+      near_axis = a;
+    }
+    if (t1 < t_far) {
+      t_far = t1;
+      far_axis = a;
+    }
+    if (t_near > t_far) return std::nullopt;
+  }
+  RayHit hit;
+  if (t_near > 0.0) {
+    if (t_near > t_max_m) return std::nullopt;
+    hit.t_m = t_near;
+    hit.face = static_cast<std::uint8_t>(2 * near_axis + (d[near_axis] < 0 ? 1 : 0));
+  } else if (t_far > 0.0) {
+    if (t_far > t_max_m) return std::nullopt;
+    hit.t_m = t_far;  // inside the box (a tunnel's rock block around the sensor): its far wall
+    hit.face = static_cast<std::uint8_t>(2 * far_axis + (d[far_axis] > 0 ? 1 : 0));
+  } else {
+    return std::nullopt;
+  }
+  return hit;
+}
+
+/// Ray-box intersection (slab test in the box frame). `t_max_m` bounds the search.
 /// Returns the entry hit (or exit hit if the origin is inside the box).
 std::optional<RayHit> intersect_box(const Box& box, const Eigen::Vector3d& origin_m,
                                     const Eigen::Vector3d& dir, double t_max_m);
 
-/// Unit outward normal of a face, in map axes.
-Eigen::Vector3d face_normal_map(const Box& box, std::uint8_t face);
+/// Unit outward normal of a face, in map axes (inline: cameras ask per pixel).
+inline Eigen::Vector3d face_normal_map(const Box& box, std::uint8_t face) {
+  const int axis = face / 2;
+  const double sign = (face % 2 == 1) ? 1.0 : -1.0;
+  return sign * box.R_map_box.col(axis);
+}
 
 /// Texture coordinates of a map point on a face, in metres along the face's two axes.
 Eigen::Vector2d face_uv_m(const Box& box, std::uint8_t face, const Eigen::Vector3d& p_map_m);

@@ -56,6 +56,11 @@ TEST(Config, DefaultsAreTheM2dgrRig) {
   EXPECT_DOUBLE_EQ(c.visible_camera.cx, 327.710279392468);
   EXPECT_DOUBLE_EQ(c.thermal_camera.fx, 435.836180277211);
   EXPECT_DOUBLE_EQ(c.extrinsics.T_imu_lidar[3], 0.27255);
+  // M2DGR has no depth: a D435's factory calibration, the stream off.
+  EXPECT_FALSE(c.depth_camera.enabled);
+  EXPECT_DOUBLE_EQ(c.depth_camera.fx, 390.431457519531);
+  EXPECT_DOUBLE_EQ(c.depth_camera.depth_unit_m, 0.001);
+  EXPECT_DOUBLE_EQ(c.extrinsics.T_cam_depth[3], 0.0143);
 }
 
 TEST(Config, EmptyFileMeansDefaults) {

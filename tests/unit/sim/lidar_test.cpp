@@ -28,6 +28,7 @@ struct LidarFixture : ::testing::Test {
     bvh = Bvh(scenario.world);
     config.T_base_lidar.translation() = Eigen::Vector3d(0.27255, -0.00053, 0.17954);
   }
+  SensorScene scene() const { return {scenario.world, bvh, scenario.trajectory}; }
   Scenario scenario;
   Bvh bvh;
   LidarModelConfig config;
@@ -37,8 +38,7 @@ struct LidarFixture : ::testing::Test {
 TEST_F(LidarFixture, DecodesBackToTheCastPointsWithinTheDistanceLsb) {
   config.noise = false;
   config.azimuth0_deg = 123.4;
-  LidarModel lidar(config, vel::builtin_calibration(vel::ProductId::kVlp32c), scenario.world, bvh,
-                   scenario.trajectory, clock, 1);
+  LidarModel lidar(config, vel::builtin_calibration(vel::ProductId::kVlp32c), scene(), clock, 1);
   vel::PacketDecoder decoder;
   vel::DecodedPacket decoded;
   std::vector<std::byte> bytes(vel::kDataPacketBytes);
@@ -67,8 +67,7 @@ TEST_F(LidarFixture, DecodesBackToTheCastPointsWithinTheDistanceLsb) {
 }
 
 TEST_F(LidarFixture, TimingIsTheSensors) {
-  LidarModel lidar(config, vel::builtin_calibration(vel::ProductId::kVlp32c), scenario.world, bvh,
-                   scenario.trajectory, clock, 2);
+  LidarModel lidar(config, vel::builtin_calibration(vel::ProductId::kVlp32c), scene(), clock, 2);
   vel::PacketDecoder decoder;
   vel::DecodedPacket decoded;
   std::vector<std::byte> bytes(vel::kDataPacketBytes);
@@ -100,8 +99,8 @@ TEST_F(LidarFixture, NoiseAndDropouts) {
   clean.noise = false;
   noisy.noise = true;
   const auto cal = vel::builtin_calibration(vel::ProductId::kVlp32c);
-  LidarModel a(clean, cal, scenario.world, bvh, scenario.trajectory, clock, 3);
-  LidarModel b(noisy, cal, scenario.world, bvh, scenario.trajectory, clock, 3);
+  LidarModel a(clean, cal, scene(), clock, 3);
+  LidarModel b(noisy, cal, scene(), clock, 3);
   std::vector<std::byte> pa(vel::kDataPacketBytes), pb(vel::kDataPacketBytes);
   double sum2 = 0;
   std::uint64_t n = 0, clean_returns = 0, noisy_returns = 0;
@@ -127,8 +126,7 @@ TEST_F(LidarFixture, NoiseAndDropouts) {
 }
 
 TEST_F(LidarFixture, PositionPacketsCarryTheSensorsTime) {
-  LidarModel lidar(config, vel::builtin_calibration(vel::ProductId::kVlp32c), scenario.world, bvh,
-                   scenario.trajectory, clock, 4);
+  LidarModel lidar(config, vel::builtin_calibration(vel::ProductId::kVlp32c), scene(), clock, 4);
   std::vector<std::byte> bytes(vel::kPositionPacketBytes);
   for (int k = 0; k < 3; ++k) {
     const Duration sent = lidar.next_position_send();

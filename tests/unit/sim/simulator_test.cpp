@@ -7,24 +7,18 @@
 
 #include <set>
 
+#include "daemon/config/config_loader.hpp"
+#include "drivers/camera/d4xx_metadata.hpp"
+#include "drivers/common/wire_format.hpp"
 #include "drivers/recording/raw_channels.hpp"
+#include "tools/sim/rig_config.hpp"
 #include "tools/sim/scenarios.hpp"
 
 namespace posed::sim {
 namespace {
 
-SimRig rig() {
-  SimRig r;
-  r.T_imu_lidar.translation() = Eigen::Vector3d(0.27255, -0.00053, 0.17954);
-  Eigen::Matrix3d R;
-  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  r.T_imu_cam.linear() = R;
-  r.T_imu_cam.translation() = Eigen::Vector3d(0.57711, 0.00012, 0.83330);
-  r.T_cam_thermal.translation() = Eigen::Vector3d(-0.17, 0, 0);
-  r.thermal = {640, 512, 435.84, 435.91, 324.45, 255.55, -0.436, 0.166, 0, 0};
-  r.visible = {640, 480, 617.97, 616.45, 327.71, 253.98, 0.148, -0.218, 0, 0};
-  return r;
-}
+/// The M2DGR rig: the schema's defaults are config/posed.yaml's values.
+SimRig rig() { return rig_from_config(config::default_config()); }
 
 TEST(Simulator, SameSeedSameBytesOtherSeedOtherWorld) {
   SimOptions o;
@@ -98,6 +92,85 @@ TEST(Simulator, StreamsRatesOrderAndGroundTruth) {
   mean_y /= static_cast<double>(frame.size() / 2);
   EXPECT_GT(mean_y, 8.0);
   EXPECT_LT(mean_y, 200.0);
+}
+
+TEST(Simulator, DepthAndRawThermalStreams) {
+  SimRig r = rig();
+  r.thermal_format = ThermalFormat::kY16;
+  SimOptions o;
+  o.scenario = "room";
+  o.duration_s = 2.0;
+  o.seed = 6;
+  o.depth_camera = true;
+  MemorySink sink;
+  SimSummary sum;
+  std::string error;
+  ASSERT_TRUE(run_simulation(r, o, sink, sum, error)) << error;
+  const int th = sink.find("thermal"), depth = sink.find("depth"), meta = sink.find("depth", 1);
+  ASSERT_TRUE(th >= 0 && depth >= 0 && meta >= 0);
+  EXPECT_EQ(sink.streams[static_cast<std::size_t>(th)].wire_format, "y16");
+  EXPECT_EQ(sink.streams[static_cast<std::size_t>(depth)].wire_format, "z16");
+  EXPECT_EQ(sink.streams[static_cast<std::size_t>(meta)].wire_format, drivers::wire::kUvcMetaD4xx);
+  EXPECT_EQ(sink.streams[static_cast<std::size_t>(depth)].metadata.at("depth_unit_m"), "0.001");
+  int frames = 0, thermal = 0;
+  std::uint32_t expected_counter = 0;
+  for (std::size_t i = 0; i < sink.messages.size(); ++i) {
+    const auto& m = sink.messages[i];
+    if (m.stream == th) {
+      EXPECT_EQ(m.bytes.size(), 640u * 512u * 2u);
+      ++thermal;
+    }
+    if (m.stream != meta) continue;
+    // Each depth frame is preceded by its metadata, delivered with it.
+    ASSERT_LT(i + 1, sink.messages.size());
+    const auto& frame = sink.messages[i + 1];
+    EXPECT_EQ(frame.stream, depth);
+    EXPECT_EQ(frame.host_time.ns, m.host_time.ns);
+    EXPECT_EQ(frame.bytes.size(), 640u * 480u * 2u);
+    drivers::camera::D4xxFrameMetadata md;
+    ASSERT_EQ(drivers::camera::parse_d4xx_metadata(m.bytes, md),
+              drivers::camera::MetadataStatus::kOk);
+    EXPECT_EQ(md.frame_counter, expected_counter++);
+    EXPECT_EQ(md.laser_power, 150u);
+    ++frames;
+  }
+  EXPECT_NEAR(frames, 30, 2);  // 15 Hz
+  EXPECT_EQ(static_cast<std::uint64_t>(frames), sum.depth_frames);
+  EXPECT_NEAR(thermal, 50, 2);
+}
+
+TEST(Simulator, NewStreamsAreDeterministicAndLeaveTheOthersAlone) {
+  SimRig r = rig();
+  SimOptions o;
+  o.scenario = "corridor";
+  o.duration_s = 1.2;
+  o.seed = 8;
+  std::string error;
+  SimSummary sum;
+  MemorySink plain;
+  ASSERT_TRUE(run_simulation(r, o, plain, sum, error)) << error;
+  r.thermal_format = ThermalFormat::kY16;
+  o.depth_camera = true;
+  HashSink a, b;
+  MemorySink full;
+  ASSERT_TRUE(run_simulation(r, o, a, sum, error)) << error;
+  ASSERT_TRUE(run_simulation(r, o, b, sum, error)) << error;
+  ASSERT_TRUE(run_simulation(r, o, full, sum, error)) << error;
+  EXPECT_EQ(a.hash(), b.hash());
+  o.seed = 9;
+  HashSink c;
+  ASSERT_TRUE(run_simulation(r, o, c, sum, error)) << error;
+  EXPECT_NE(a.hash(), c.hash());
+  // Turning depth on and thermal to y16 changes neither the lidar, IMU nor colour bytes.
+  for (const char* name : {"imu", "lidar", "visible"}) {
+    std::vector<std::vector<std::byte>> before, after;
+    for (const auto& m : plain.messages)
+      if (m.stream == plain.find(name)) before.push_back(m.bytes);
+    for (const auto& m : full.messages)
+      if (m.stream == full.find(name)) after.push_back(m.bytes);
+    EXPECT_FALSE(before.empty()) << name;
+    EXPECT_EQ(before, after) << name;
+  }
 }
 
 TEST(Simulator, RejectsUnknownScenario) {

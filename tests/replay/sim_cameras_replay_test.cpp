@@ -1,0 +1,84 @@
+// Every camera stream the simulator writes, replayed by posed as a user runs it: `posectl sim
+// --depth --thermal-format y16` records colour frames with their D4xx metadata, 16-bit raw
+// thermal frames and the D435i's depth stream; `posed --replay --max-speed` decodes the colour
+// and y16 thermal frames (y16 -> mono16) without a malformed one, says once that the depth
+// stream has no stage, and exits cleanly.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <regex>
+#include <string>
+
+#include "tests/integration/posed_process.hpp"
+
+namespace posed::testing {
+// Named rather than anonymous: test binaries build as unity batches.
+namespace sim_cameras_replay_test {
+
+using namespace std::chrono_literals;
+
+int test_domain() { return 1 + static_cast<int>((::getpid() + 61) % 99); }
+
+/// Occurrences of `needle` in `text`.
+std::size_t count(const std::string& text, const std::string& needle) {
+  std::size_t n = 0;
+  for (auto at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+  return n;
+}
+
+TEST(SimCamerasReplay, DepthIsSkippedOnceAndRawThermalDecodes) {
+  TempDir dir;
+  const std::string recording = dir.file("cameras.mcap");
+  int visible_frames = 0, thermal_frames = 0;
+  {
+    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "room",
+                      "--duration", "3", "--seed", "3", "--depth", "--thermal-format", "y16",
+                      "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+                     {}, dir);
+    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const std::string out = sim.out();
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        out, m,
+        std::regex(R"(visible (\d+) frames; thermal (\d+) frames \(y16\); depth (\d+) frames)")))
+        << out;
+    visible_frames = std::stoi(m[1]);
+    thermal_frames = std::stoi(m[2]);
+    EXPECT_NEAR(visible_frames, 45, 2);  // 15 Hz
+    EXPECT_NEAR(thermal_frames, 75, 2);  // 25 Hz
+    EXPECT_NEAR(std::stoi(m[3]), 45, 2);
+  }
+  const std::string config =
+      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
+                                  "\n  cyclonedds_config: " + source_dir() +
+                                  "/config/cyclonedds-loopback.xml\n");
+  PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
+                      "--max-speed", "--wait-subscribers", "0"},
+                     {}, dir);
+  ASSERT_EQ(posed.wait_for_exit(120s), 0) << posed.err();
+  const std::string out = posed.out(), err = posed.err();
+  EXPECT_EQ(count(err, "no pipeline stage for stream(s) depth: not replayed"), 1u) << err;
+  EXPECT_EQ(count(err, "error"), 0u) << err;
+  EXPECT_NE(out.find("(depth (not replayed), imu, lidar, thermal, visible)"), std::string::npos)
+      << out;
+  // Every frame decoded, none malformed or dropped; colour stamped from its hardware clock.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m,
+                                std::regex(R"(thermal +(\d+) decoded .*, (\d+) malformed, (\d+) )"
+                                           R"(dropped; clock (\w+))")))
+      << out;
+  EXPECT_EQ(std::stoi(m[1]), thermal_frames);
+  EXPECT_EQ(std::stoi(m[2]), 0);
+  EXPECT_EQ(std::stoi(m[3]), 0);
+  ASSERT_TRUE(std::regex_search(
+      out, m,
+      std::regex(R"(visible +(\d+) decoded .*, (\d+) malformed, (\d+) dropped; clock (\w+))")))
+      << out;
+  EXPECT_EQ(std::stoi(m[1]), visible_frames);
+  EXPECT_EQ(std::stoi(m[2]), 0);
+  EXPECT_EQ(m[4], "locked");
+}
+
+}  // namespace sim_cameras_replay_test
+}  // namespace posed::testing
