@@ -60,11 +60,14 @@ function(posed_library name)
   endif()
 endfunction()
 
-# posed_test(<name> LABEL unit|replay|integration|hw SOURCES ... [LIBS ...] [RESOURCE_LOCK lock]):
+# posed_test(<name> LABEL unit|replay|integration|hw SOURCES ... [LIBS ...] [RESOURCE_LOCK lock]
+#            [REAL_TIME]):
 # one GoogleTest binary per area, each test discovered and labelled for ctest -L. Tests sharing a
 # RESOURCE_LOCK (a fixed port, a machine-wide device) never run at the same time under ctest -j.
+# REAL_TIME tests run a live posed against data paced in real time: they run alone (RUN_SERIAL),
+# since on a 2-core machine a neighbouring test starves the live pipeline and its queues drop.
 function(posed_test name)
-  cmake_parse_arguments(ARG "" "LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "REAL_TIME" "LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS" ${ARGN})
   if(NOT ARG_LABEL)
     message(FATAL_ERROR "posed_test(${name}) needs a LABEL")
   endif()
@@ -90,6 +93,9 @@ function(posed_test name)
   set(lock_property "")
   if(ARG_RESOURCE_LOCK)
     set(lock_property RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
+  if(ARG_REAL_TIME)
+    list(APPEND lock_property RUN_SERIAL TRUE)
   endif()
   gtest_discover_tests(${name}
     PROPERTIES LABELS ${ARG_LABEL} TIMEOUT ${ARG_TIMEOUT} ${lock_property}
