@@ -66,8 +66,12 @@ endfunction()
 # RESOURCE_LOCK (a fixed port, a machine-wide device) never run at the same time under ctest -j.
 # REAL_TIME tests run a live posed against data paced in real time: they run alone (RUN_SERIAL),
 # since on a 2-core machine a neighbouring test starves the live pipeline and its queues drop.
+# Unit tests join the aggregate `sanitized_tests` that CI builds under ASan/UBSan, except those
+# marked NOT_SANITIZED: numerical code on well-formed input (the simulator, trajectory
+# evaluation, whole lidar drives), which takes minutes under ASan and parses no outside bytes.
 function(posed_test name)
-  cmake_parse_arguments(ARG "REAL_TIME" "LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "REAL_TIME;NOT_SANITIZED" "LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS"
+                        ${ARGN})
   if(NOT ARG_LABEL)
     message(FATAL_ERROR "posed_test(${name}) needs a LABEL")
   endif()
@@ -84,6 +88,12 @@ function(posed_test name)
     add_custom_target(${ARG_LABEL}_tests)
   endif()
   add_dependencies(${ARG_LABEL}_tests ${name})
+  if(ARG_LABEL STREQUAL "unit" AND NOT ARG_NOT_SANITIZED)
+    if(NOT TARGET sanitized_tests)
+      add_custom_target(sanitized_tests)
+    endif()
+    add_dependencies(sanitized_tests ${name})
+  endif()
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
   posed_target_defaults(${name})
   # Where the tests find the sources (config/, ../shared/realdata) and the built executables;

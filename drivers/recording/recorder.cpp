@@ -242,7 +242,7 @@ void Recorder::run() {
     }
     current_bytes_.store(writer_.file_size_bytes(), std::memory_order_relaxed);
     const HostTime now = host_now();
-    if (now - last_flush >= options_.flush_interval) {
+    if (options_.flush_interval.ns > 0 && now - last_flush >= options_.flush_interval) {
       writer_.flush_chunk();
       last_flush = now;
     }

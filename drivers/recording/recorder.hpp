@@ -45,7 +45,8 @@ struct RecorderOptions {
   std::uint64_t rotate_bytes = 0;
   /// start a new file once it spans this much log time; 0 = never
   Duration rotate_after = Duration::from_ns(0);
-  /// close the open chunk at least this often, so slow streams reach the disk (host clock)
+  /// close the open chunk at least this often, so slow streams reach the disk (host clock);
+  /// 0 = only when full, so the file's bytes depend on what was recorded alone, not on when
   Duration flush_interval = Duration::from_ms(1000);
   /// wall minus host time; when unset (0) it is sampled once in open()
   HostToWall host_to_wall{Duration::from_ns(0)};

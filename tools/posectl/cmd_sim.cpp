@@ -170,6 +170,9 @@ int run_sim(int argc, char** argv) {
   drivers::recording::RecorderOptions ropt;
   // A fixed host-to-wall offset (not the machine's clock) keeps the file a function of the seed.
   ropt.host_to_wall = HostToWall{Duration::from_ns(sim::kSimWallStartNs - options.host_epoch_ns)};
+  // Chunks close when full, never on the writer thread's clock: the same seed writes the same
+  // file, byte for byte.
+  ropt.flush_interval = Duration::from_ns(0);
   drivers::recording::Recorder recorder;
   if (!recorder.open(out_path, ropt, error)) {
     std::fprintf(stderr, "posectl sim: %s\n", error.c_str());

@@ -10,7 +10,7 @@
 #include "drivers/velodyne/packet_format.hpp"
 #include "drivers/velodyne/position_packet.hpp"
 #include "tools/sim/bvh.hpp"
-#include "tools/sim/d4xx_metadata_encoder.hpp"
+#include "drivers/camera/d4xx_metadata_writer.hpp"
 #include "tools/sim/lidar_model.hpp"
 #include "tools/sim/scenarios.hpp"
 #include "tools/sim/visible_camera.hpp"

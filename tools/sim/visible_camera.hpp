@@ -10,13 +10,19 @@
 #include <vector>
 
 #include "core/time.hpp"
+#include "drivers/camera/d4xx_metadata_writer.hpp"
 #include "tools/sim/clock_model.hpp"
-#include "tools/sim/d4xx_metadata_encoder.hpp"
 #include "tools/sim/fast_noise.hpp"
 #include "tools/sim/gbuffer.hpp"
 #include "tools/sim/sensor_scene.hpp"
 
 namespace posed::sim {
+
+// The D435i's frame metadata is written by the driver layer's writer (tests use it too).
+using drivers::camera::D4xxFrameFacts;
+using drivers::camera::D4xxNode;
+using drivers::camera::encode_d4xx_metadata;
+using drivers::camera::set_usb_arrival;
 
 struct VisibleCameraConfig {
   CameraIntrinsics intrinsics;

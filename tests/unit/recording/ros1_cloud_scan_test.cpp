@@ -42,6 +42,7 @@ std::vector<std::byte> velodyne_cloud(const std::vector<P>& points, std::int64_t
                            ser::velodyne_fields(), ser::kVelodynePointStep, data);
 }
 
+/// The cloud views `bytes`, which must outlive it (a temporary does not).
 ros1::PointCloud2 decode(const std::vector<std::byte>& bytes) {
   ros1::PointCloud2 cloud;
   EXPECT_EQ(ros1::decode_point_cloud2(bytes, cloud), ros1::Ros1Status::kOk);
@@ -193,7 +194,9 @@ TEST(CloudScan, AFullOrSmallPoolIsAStatusNotACrash) {
     const auto f = static_cast<float>(i);
     points.push_back({10.f + f, 0, 0, 0, 0, 0.001f * f});
   }
-  const auto cloud = decode(velodyne_cloud(points, kStamp));
+  // The decoded cloud views the message bytes: they must outlive it.
+  const std::vector<std::byte> message = velodyne_cloud(points, kStamp);
+  const auto cloud = decode(message);
   PayloadPool small(1, 4 * sizeof(LidarPoint));
   ros1::CloudScanDecoder decoder(small, {});
   LidarScan scan;

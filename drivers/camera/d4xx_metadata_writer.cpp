@@ -1,13 +1,11 @@
-#include "tools/sim/d4xx_metadata_encoder.hpp"
+#include "drivers/camera/d4xx_metadata_writer.hpp"
 
 #include <cmath>
 
 #include "drivers/camera/d4xx_metadata.hpp"
 
-namespace posed::sim {
+namespace posed::drivers::camera {
 namespace {
-
-namespace cam = drivers::camera;
 
 /// librealsense's md_type for md_capture_stats (the parser skips the block by its size).
 constexpr std::uint32_t kMdCaptureStatsId = 0x00000003u;
@@ -24,7 +22,7 @@ struct LittleEndian {
 };
 
 void capture_timing(LittleEndian& b, const D4xxFrameFacts& f) {
-  b.u32(cam::kMdCaptureTimingId);
+  b.u32(kMdCaptureTimingId);
   b.u32(40);
   b.u32(1);     // version
   b.u32(0x3F);  // flags: every field below valid
@@ -49,7 +47,7 @@ void capture_stats(LittleEndian& b, const D4xxFrameFacts& f) {
 }
 
 void configuration(LittleEndian& b, const D4xxFrameFacts& f) {
-  b.u32(cam::kMdConfigurationId);
+  b.u32(kMdConfigurationId);
   b.u32(40);
   b.u32(3);      // version
   b.u32(0x1FF);  // flags
@@ -71,7 +69,7 @@ void rgb_control(LittleEndian& b, const D4xxFrameFacts& f) {
   // version, flags, brightness, contrast, saturation, sharpness, ae_mode, awb_temp, gain,
   // backlight_comp, gamma, hue, manual_exp [100 us], manual_wb, power_line_frequency,
   // low_light_comp
-  b.u32(cam::kMdRgbControlId);
+  b.u32(kMdRgbControlId);
   b.u32(72);
   const std::uint32_t rgb[16] = {
       2, 0x3FFF, 0, 50, 64, 50, 1, 4600, f.gain, 0, 300, 0, f.exposure_time_us / 100, 4600, 1, 0};
@@ -82,7 +80,7 @@ void depth_control(LittleEndian& b, const D4xxFrameFacts& f) {
   // version, flags (gain, exposure, laser power, ae mode, priority, roi, preset), manual_gain,
   // manual_exposure [us], laser_power [mW], auto_exposure_mode, exposure_priority, the
   // auto-exposure ROI (left, right, top, bottom) [px], preset, laser power mode (1 = on)
-  b.u32(cam::kMdDepthControlId);
+  b.u32(kMdDepthControlId);
   b.u32(60);
   const std::uint32_t roi_left = f.width_px / 8u, roi_right = f.width_px - f.width_px / 8u;
   const std::uint32_t roi_top = f.height_px / 8u, roi_bottom = f.height_px - f.height_px / 8u;
@@ -121,7 +119,7 @@ void encode_d4xx_metadata(const D4xxFrameFacts& f, std::vector<std::byte>& out) 
     rgb_control(b, f);
   }
   // bHeaderLength is one byte: the depth layout's 232 bytes are the largest that fits.
-  out[length_at] = static_cast<std::byte>(out.size() - cam::kUvcMetaBufPrefixBytes);
+  out[length_at] = static_cast<std::byte>(out.size() - kUvcMetaBufPrefixBytes);
 }
 
-}  // namespace posed::sim
+}  // namespace posed::drivers::camera

@@ -1,17 +1,17 @@
 #pragma once
-// The D435i's per-frame metadata as the uvcvideo metadata node delivers it, for the simulator:
-// the exact layout drivers/camera/d4xx_metadata.hpp parses (struct uvc_meta_buf of
-// linux/uvcvideo.h, the UVC payload header with PTS and SCR, then librealsense's metadata
-// blocks, #pragma pack(1), md_size counting the md_header as firmware does). The colour node
-// sends md_capture_timing, md_configuration and md_rgb_control; the depth node librealsense's
-// md_depth_y_normal_mode: md_capture_timing, md_capture_stats, md_depth_control (gain,
-// exposure, laser power) and md_configuration.
+// The D435i's per-frame metadata as the uvcvideo metadata node delivers it, written: for the
+// simulator (tools/sim) and for tests that need real metadata buffers. The exact layout
+// drivers/camera/d4xx_metadata.hpp parses (struct uvc_meta_buf of linux/uvcvideo.h, the UVC payload
+// header with PTS and SCR, then librealsense's metadata blocks, #pragma pack(1), md_size counting
+// the md_header as firmware does). The colour node sends md_capture_timing, md_configuration and
+// md_rgb_control; the depth node librealsense's md_depth_y_normal_mode: md_capture_timing,
+// md_capture_stats, md_depth_control (gain, exposure, laser power) and md_configuration.
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
-namespace posed::sim {
+namespace posed::drivers::camera {
 
 /// Which of the D435i's UVC nodes sent the frame.
 enum class D4xxNode : std::uint8_t {
@@ -43,4 +43,4 @@ void set_usb_arrival(D4xxFrameFacts& facts, std::int64_t arrival_ns);
 /// Replaces `out` with the metadata buffer of one frame.
 void encode_d4xx_metadata(const D4xxFrameFacts& facts, std::vector<std::byte>& out);
 
-}  // namespace posed::sim
+}  // namespace posed::drivers::camera
