@@ -58,6 +58,7 @@ bool Recorder::open_file(std::string& error) {
       {{std::string(raw::kHostToWallKey), std::to_string(options_.host_to_wall.wall_minus_host.ns)},
        {"file_index", std::to_string(file_index_)},
        {"log_time_clock", "host CLOCK_MONOTONIC [ns]"}});
+  for (const auto& [record, entries] : options_.metadata) writer_.write_metadata(record, entries);
   register_channels();
   return true;
 }

@@ -50,6 +50,9 @@ struct RecorderOptions {
   Duration flush_interval = Duration::from_ms(1000);
   /// wall minus host time; when unset (0) it is sampled once in open()
   HostToWall host_to_wall{Duration::from_ns(0)};
+  /// further Metadata records (name -> entries) written at the start of every file, e.g. how a
+  /// simulated recording was made
+  std::map<std::string, std::map<std::string, std::string>> metadata;
 };
 
 struct RecorderChannelCounters {

@@ -18,6 +18,7 @@
 #include "daemon/pipeline/pipeline.hpp"
 #include "daemon/pipeline/replay_sources.hpp"
 #include "tools/posectl/commands.hpp"
+#include "tools/posectl/frontend_depth_truth.hpp"
 #include "tools/posectl/frontend_snapshots.hpp"
 #include "tools/posectl/terminal_progress.hpp"
 
@@ -49,7 +50,8 @@ std::string number(double v, const char* format) {
   return text;
 }
 
-void print_table(const std::vector<const CameraFigures*>& columns) {
+void print_table(const std::vector<const CameraFigures*>& columns,
+                 const FrontendDepthTruth* truth) {
   std::printf("%-46s", "");
   for (const CameraFigures* c : columns) std::printf("%12s", std::string(c->mode).c_str());
   std::printf("\n");
@@ -78,6 +80,27 @@ void print_table(const std::vector<const CameraFigures*>& columns) {
   row("depth association [% of features]", [](const CameraFigures& c) {
     return percent(static_cast<double>(c.depth_total), static_cast<double>(c.features_total));
   });
+  if (truth != nullptr) {
+    const auto stats = [truth](const CameraFigures& c) {
+      vision::FrontendMode mode = vision::FrontendMode::kFused;
+      for (const vision::FrontendMode m : kModes) {
+        if (vision::to_string(m) == c.mode) mode = m;
+      }
+      return truth->stats(mode);
+    };
+    row("lidar depth error vs truth, median [m]", [&](const CameraFigures& c) {
+      const DepthErrorStats s = stats(c);
+      return s.features > 0 ? number(s.median_abs_m, "%.3f") : std::string("-");
+    });
+    row("lidar depth error vs truth, p90 [m]", [&](const CameraFigures& c) {
+      const DepthErrorStats s = stats(c);
+      return s.features > 0 ? number(s.p90_abs_m, "%.3f") : std::string("-");
+    });
+    row("lidar depth within 10 % of truth [%]", [&](const CameraFigures& c) {
+      const DepthErrorStats s = stats(c);
+      return s.features > 0 ? number(100.0 * s.within_10_percent, "%.1f") : std::string("-");
+    });
+  }
   const char* quality_names[3] = {"mean confidence, visible [0..1]",
                                   "mean confidence, thermal [0..1]",
                                   "mean confidence, fused [0..1]"};
@@ -146,13 +169,20 @@ int run_inspect_frontend(int argc, char** argv) {
   if (!note.empty()) std::fprintf(stderr, "posectl inspect frontend: %s\n", note.c_str());
 
   FrontendSnapshots observer(snapshots);
+  // A simulated recording's world gives each feature's true depth.
+  std::string truth_note;
+  std::unique_ptr<FrontendDepthTruth> truth =
+      FrontendDepthTruth::for_recording(path, config, truth_note);
+  FrontendObservers observers;
+  observers.add(&observer);
+  observers.add(truth.get());
   pipeline::PipelineOutputs outputs;
   outputs.on_state = [](const NavState&) {};
   outputs.on_status = [](const pipeline::PipelineStatus&) {};
   for (const vision::FrontendMode m : kModes) {
     if (m != primary.frontend.mode) outputs.frontend_compare_modes.push_back(m);
   }
-  outputs.frontend_observer = &observer;
+  outputs.frontend_observer = &observers;
   pipeline::Pipeline pipe(config, std::move(replay.built.sources), std::move(outputs));
   if (!pipe.start(error)) {
     std::fprintf(stderr, "posectl inspect frontend: %s\n", error.c_str());
@@ -195,8 +225,10 @@ int run_inspect_frontend(int argc, char** argv) {
                 static_cast<unsigned long long>(s.malformed),
                 static_cast<unsigned long long>(s.dropped), s.clock_state.c_str());
   }
-  std::printf("\n");
-  print_table(columns);
+  std::printf("  depth truth: %s\n\n",
+              truth ? ("the simulator's world, " + truth->description()).c_str()
+                    : ("none: " + truth_note).c_str());
+  print_table(columns, truth.get());
   if (!snapshots.directory.empty()) {
     std::printf("\n%zu annotated frames in %s\n", observer.written().size(),
                 snapshots.directory.c_str());

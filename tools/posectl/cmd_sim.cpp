@@ -167,12 +167,26 @@ int run_sim(int argc, char** argv) {
     }
   }
 
+  const auto exact = [](double v) {  // round-trips through strtod
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return std::string(text);
+  };
   drivers::recording::RecorderOptions ropt;
   // A fixed host-to-wall offset (not the machine's clock) keeps the file a function of the seed.
   ropt.host_to_wall = HostToWall{Duration::from_ns(sim::kSimWallStartNs - options.host_epoch_ns)};
   // Chunks close when full, never on the writer thread's clock: the same seed writes the same
   // file, byte for byte.
   ropt.flush_interval = Duration::from_ns(0);
+  // How the run was made, so tools can rebuild its world (posectl inspect frontend measures
+  // lidar depth against it) and a person can reproduce it.
+  ropt.metadata[std::string(sim::kSimMetadataName)] = {
+      {"scenario", scenario},
+      {"seed", std::to_string(seed)},
+      {"duration_s", exact(duration_s)},
+      {"host_epoch_ns", std::to_string(options.host_epoch_ns)},
+      {"gravity_mps2", exact(rig.gravity_mps2)},
+      {"noise", options.noise ? "true" : "false"}};
   drivers::recording::Recorder recorder;
   if (!recorder.open(out_path, ropt, error)) {
     std::fprintf(stderr, "posectl sim: %s\n", error.c_str());

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 
 #include "drivers/imu/a9_protocol.hpp"
 #include "drivers/velodyne/calibration.hpp"
@@ -102,5 +103,8 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
 
 /// The wall time the simulated recording claims to start at: 2024-06-01T12:00:00Z [ns].
 inline constexpr std::int64_t kSimWallStartNs = 1'717'243'200'000'000'000;
+/// The Metadata record `posectl sim` writes: scenario, seed, duration_s, host_epoch_ns,
+/// gravity_mps2, noise (make_scenario() rebuilds the world and drive from them).
+inline constexpr std::string_view kSimMetadataName = "posed.sim";
 
 }  // namespace posed::sim
