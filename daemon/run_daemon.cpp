@@ -15,10 +15,12 @@
 #include "daemon/dds/publisher.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
+#include "daemon/pipeline/camera_calibration.hpp"
 #include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/pipeline.hpp"
 #include "daemon/pipeline/recording_tap.hpp"
 #include "daemon/pipeline/source_factory.hpp"
+#include "drivers/camera/libusb_transport.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
 #include "drivers/recording/map_files.hpp"
@@ -96,7 +98,9 @@ std::string keyframes_path_for(const std::string& map_path) {
   return map_path + ".keyframes.tum";
 }
 
-int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
+int run_daemon(const config::PosedConfig& configured, const RunOptions& options) {
+  // What runs: the configuration, with what the devices say of themselves (calibration).
+  config::PosedConfig config = configured;
   // Signals are taken synchronously by this thread; the stage threads inherit the mask.
   sigset_t signals;
   sigemptyset(&signals);
@@ -132,6 +136,11 @@ int run_daemon(const config::PosedConfig& config, const RunOptions& options) {
     built = std::move(replay.built);
     replay_streams = replay.streams;
   } else {
+    if (config.visible_camera.enabled && config.visible_camera.source == "v4l2") {
+      drivers::camera::LibusbTransport usb;
+      const std::string line = pipeline::apply_d435i_factory_calibration(config, usb);
+      if (!line.empty()) POSED_LOG_INFO("%s", line.c_str());
+    }
     built = pipeline::make_sources(config, error);
   }
   if (!built.sources.imu) {

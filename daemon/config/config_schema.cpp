@@ -109,6 +109,10 @@ const Field kSchema[] = {
       "how the camera is read: V4L2 (UVC) or GenICam through Aravis"),
     F("visible_camera.format", visible_camera.format, "yuyv", "", 0, 0,
       "yuyv|uyvy|rgb8|bgr8|mjpeg|y8|y16", "pixel format negotiated with the camera"),
+    F("visible_camera.intrinsics_source", visible_camera.intrinsics_source, "factory", "", 0, 0,
+      "factory|config",
+      "factory: the D435i's own calibration over USB, the values below when it cannot be read; "
+      "config: the values below"),
     F("visible_camera.width", visible_camera.width, "640", "px", 1, 8192, "", "image width"),
     F("visible_camera.height", visible_camera.height, "480", "px", 1, 8192, "", "image height"),
     F("visible_camera.rate_hz", visible_camera.rate_hz, "15", "Hz", 1, 120, "", "frame rate"),

@@ -78,6 +78,7 @@ struct CameraSection {
   std::string device;                     ///< V4L2 path, /dev/v4l/by-id/..., or serial
   std::string source;                     ///< v4l2 | aravis
   std::string format;                     ///< wire pixel format (yuyv, y8, y16, mjpeg, ...)
+  std::string intrinsics_source = "factory";  ///< factory (D435i HW monitor) | config
   int width = 0;                          ///< [px]
   int height = 0;                         ///< [px]
   double rate_hz = 0;                     ///< [Hz]
