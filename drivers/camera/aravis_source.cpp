@@ -217,11 +217,11 @@ ReadStatus AravisSource::read(RawChunk& chunk, Duration timeout) {
     if (!open(error)) return ReadStatus::kDeviceLost;
     impl_->lost = false;
     ++frame_counters_.reopened;
-    reopened_.fetch_add(1, std::memory_order_relaxed);
+    counts_.reopened.fetch_add(1, std::memory_order_relaxed);
     POSED_LOG_NOTICE("%s: genicam camera '%s' reopened", name_.c_str(), config_.camera_id.c_str());
   }
   if (impl_->camera == nullptr) {
-    rejected_.fetch_add(1, std::memory_order_relaxed);
+    counts_.rejected.fetch_add(1, std::memory_order_relaxed);
     return ReadStatus::kTimeout;  // never opened: the caller opens first
   }
   if (impl_->control_lost.load(std::memory_order_relaxed)) {
@@ -269,18 +269,10 @@ ReadStatus AravisSource::read(RawChunk& chunk, Duration timeout) {
   chunk.bytes = {static_cast<const std::byte*>(data), data != nullptr ? size : 0};
   chunk.host_receive = frame_.host_receive;
   chunk.channel = 0;
-  chunks_.fetch_add(1, std::memory_order_relaxed);
-  bytes_.fetch_add(chunk.bytes.size(), std::memory_order_relaxed);
+  counts_.count_chunk(chunk.bytes.size());
   return ReadStatus::kData;
 }
 
-SourceCounters AravisSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.rejected = rejected_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters AravisSource::counters() const { return counts_.snapshot(); }
 
 }  // namespace posed::drivers::camera

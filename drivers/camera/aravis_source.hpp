@@ -115,7 +115,7 @@ class AravisSource final : public Source {
   bool have_frame_id_ = false;
   std::uint64_t last_frame_id_ = 0;
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, rejected_{0}, reopened_{0};
+  AtomicSourceCounters counts_;
 };
 
 }  // namespace posed::drivers::camera

@@ -120,8 +120,7 @@ ReadStatus D4xxVideoSource::deliver_frame(RawChunk& chunk) {
   chunk.host_receive = frame_.host_receive;
   chunk.channel = 0;
   ++pairing_.frames;
-  chunks_.fetch_add(1, std::memory_order_relaxed);
-  bytes_.fetch_add(frame_.bytes.size(), std::memory_order_relaxed);
+  counts_.count_chunk(frame_.bytes.size());
   return ReadStatus::kData;
 }
 
@@ -136,7 +135,7 @@ ReadStatus D4xxVideoSource::read(RawChunk& chunk, Duration timeout) {
     return deliver_frame(chunk);
   }
   const CaptureStatus s = video_.next(frame_, timeout);
-  reopened_.store(video_.counters().reopened, std::memory_order_relaxed);
+  counts_.reopened.store(video_.counters().reopened, std::memory_order_relaxed);
   switch (s) {
     case CaptureStatus::kFrame:
       break;
@@ -148,7 +147,7 @@ ReadStatus D4xxVideoSource::read(RawChunk& chunk, Duration timeout) {
       holding_metadata_ = false;
       return ReadStatus::kDeviceLost;
     case CaptureStatus::kError:
-      rejected_.fetch_add(1, std::memory_order_relaxed);
+      counts_.rejected.fetch_add(1, std::memory_order_relaxed);
       return ReadStatus::kTimeout;
   }
   if (video_.counters().reopened != video_reopens_seen_) {
@@ -162,21 +161,13 @@ ReadStatus D4xxVideoSource::read(RawChunk& chunk, Duration timeout) {
     chunk.bytes = metadata_frame_.bytes;
     chunk.host_receive = metadata_frame_.host_receive;
     chunk.channel = 1;
-    chunks_.fetch_add(1, std::memory_order_relaxed);
-    bytes_.fetch_add(metadata_frame_.bytes.size(), std::memory_order_relaxed);
+    counts_.count_chunk(metadata_frame_.bytes.size());
     return ReadStatus::kData;
   }
   ++pairing_.frames_without_metadata;
   return deliver_frame(chunk);
 }
 
-SourceCounters D4xxVideoSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.rejected = rejected_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters D4xxVideoSource::counters() const { return counts_.snapshot(); }
 
 }  // namespace posed::drivers::camera

@@ -95,7 +95,7 @@ class D4xxVideoSource final : public Source {
   std::uint64_t video_reopens_seen_ = 0;
   D4xxVideoCounters pairing_;
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, rejected_{0}, reopened_{0};
+  AtomicSourceCounters counts_;
 };
 
 }  // namespace posed::drivers::camera

@@ -69,8 +69,7 @@ bool RealsenseImuSource::deliver(std::uint32_t channel, RawChunk& chunk) {
   chunk.host_receive = host_now();
   c.delivered += whole;
   (channel == 0 ? imu_counters_.accel_records : imu_counters_.gyro_records) += whole / record;
-  chunks_.fetch_add(1, std::memory_order_relaxed);
-  bytes_.fetch_add(whole, std::memory_order_relaxed);
+  counts_.count_chunk(whole);
   return true;
 }
 
@@ -86,7 +85,7 @@ ReadStatus RealsenseImuSource::read(RawChunk& chunk, Duration timeout) {
     std::string error;
     if (!open(error)) return ReadStatus::kDeviceLost;
     lost_ = false;
-    reopened_.fetch_add(1, std::memory_order_relaxed);
+    counts_.reopened.fetch_add(1, std::memory_order_relaxed);
     POSED_LOG_NOTICE("imu %s: IIO devices back, reopened", name_.c_str());
   }
   // The previous chunk's bytes are released now: move the partial tail to the front.
@@ -122,7 +121,7 @@ ReadStatus RealsenseImuSource::read(RawChunk& chunk, Duration timeout) {
     }
     if (c.filled == c.buffer.size() && c.filled % c.device.layout.record_bytes != 0) {
       // Cannot happen with whole-record kernel reads; guard so a full buffer never stalls.
-      rejected_.fetch_add(1, std::memory_order_relaxed);
+      counts_.rejected.fetch_add(1, std::memory_order_relaxed);
       c.filled = 0;
     }
   }
@@ -131,13 +130,6 @@ ReadStatus RealsenseImuSource::read(RawChunk& chunk, Duration timeout) {
   return ReadStatus::kTimeout;
 }
 
-SourceCounters RealsenseImuSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.rejected = rejected_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters RealsenseImuSource::counters() const { return counts_.snapshot(); }
 
 }  // namespace posed::drivers::camera

@@ -74,7 +74,7 @@ class RealsenseImuSource final : public Source {
   bool lost_ = false;
   RealsenseImuSourceCounters imu_counters_;
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, rejected_{0}, reopened_{0};
+  AtomicSourceCounters counts_;
 };
 
 }  // namespace posed::drivers::camera

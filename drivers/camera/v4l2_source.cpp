@@ -13,14 +13,13 @@ ReadStatus V4l2Source::read(RawChunk& chunk, Duration timeout) {
     return ReadStatus::kEndOfStream;
   }
   const CaptureStatus s = capture_.next(frame_, timeout);
-  reopened_.store(capture_.counters().reopened, std::memory_order_relaxed);
+  counts_.reopened.store(capture_.counters().reopened, std::memory_order_relaxed);
   switch (s) {
     case CaptureStatus::kFrame:
       chunk.bytes = frame_.bytes;
       chunk.host_receive = frame_.host_receive;
       chunk.channel = 0;
-      chunks_.fetch_add(1, std::memory_order_relaxed);
-      bytes_.fetch_add(frame_.bytes.size(), std::memory_order_relaxed);
+      counts_.count_chunk(frame_.bytes.size());
       return ReadStatus::kData;
     case CaptureStatus::kTimeout:
       return ReadStatus::kTimeout;
@@ -29,19 +28,12 @@ ReadStatus V4l2Source::read(RawChunk& chunk, Duration timeout) {
     case CaptureStatus::kError:
       // Not open, or a failure the driver may recover from: the caller retries like a timeout;
       // the error text stays in capture().last_error().
-      rejected_.fetch_add(1, std::memory_order_relaxed);
+      counts_.rejected.fetch_add(1, std::memory_order_relaxed);
       return ReadStatus::kTimeout;
   }
   return ReadStatus::kTimeout;
 }
 
-SourceCounters V4l2Source::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.rejected = rejected_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters V4l2Source::counters() const { return counts_.snapshot(); }
 
 }  // namespace posed::drivers::camera

@@ -35,7 +35,7 @@ class V4l2Source final : public Source {
   V4l2Capture capture_;
   V4l2Frame frame_;
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, rejected_{0}, reopened_{0};
+  AtomicSourceCounters counts_;
 };
 
 }  // namespace posed::drivers::camera

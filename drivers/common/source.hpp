@@ -3,6 +3,7 @@
 // one interface, never a mode flag inside a driver. The recorder taps RawChunks here, before
 // decoding, so a replay exercises decoding, clock sync and fusion exactly as on the robot.
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -50,6 +51,25 @@ struct SourceCounters {
   std::uint64_t bytes = 0;     ///< [B]
   std::uint64_t rejected = 0;  ///< chunks refused at the Source (wrong sender, oversize, ...)
   std::uint64_t reopened = 0;  ///< times the device was lost and opened again
+};
+
+/// SourceCounters as a Source keeps them: counted by its reading thread, read by the status
+/// snapshot from any other thread (relaxed: each figure is a monotonic count on its own).
+struct AtomicSourceCounters {
+  std::atomic<std::uint64_t> chunks{0};    ///< reads that returned data
+  std::atomic<std::uint64_t> bytes{0};     ///< [B]
+  std::atomic<std::uint64_t> rejected{0};  ///< chunks refused at the Source
+  std::atomic<std::uint64_t> reopened{0};  ///< times the device was lost and opened again
+
+  /// One chunk of `size` bytes handed out.
+  void count_chunk(std::size_t size) {
+    chunks.fetch_add(1, std::memory_order_relaxed);
+    bytes.fetch_add(size, std::memory_order_relaxed);
+  }
+  SourceCounters snapshot() const {
+    return {chunks.load(std::memory_order_relaxed), bytes.load(std::memory_order_relaxed),
+            rejected.load(std::memory_order_relaxed), reopened.load(std::memory_order_relaxed)};
+  }
 };
 
 class Source {

@@ -147,7 +147,7 @@ ReadStatus SerialSource::read(RawChunk& chunk, Duration timeout) {
         return ReadStatus::kDeviceLost;
       }
       lost_ = false;
-      reopened_.fetch_add(1, std::memory_order_relaxed);
+      counts_.reopened.fetch_add(1, std::memory_order_relaxed);
       POSED_LOG_NOTICE("%s: serial device %s back after %u failed attempt(s)", config_.name.c_str(),
                        config_.path.c_str(), reopen_attempts_);
     }
@@ -176,8 +176,7 @@ ReadStatus SerialSource::read(RawChunk& chunk, Duration timeout) {
       chunk.bytes = std::span<const std::byte>(buffer_.data(), static_cast<std::size_t>(got));
       chunk.host_receive = received;
       chunk.channel = 0;
-      chunks_.fetch_add(1, std::memory_order_relaxed);
-      bytes_.fetch_add(static_cast<std::uint64_t>(got), std::memory_order_relaxed);
+      counts_.count_chunk(static_cast<std::uint64_t>(got));
       return ReadStatus::kData;
     }
     if (got < 0 && (errno == EAGAIN || errno == EINTR)) {
@@ -201,12 +200,6 @@ void SerialSource::request_stop() {
   }
 }
 
-SourceCounters SerialSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters SerialSource::counters() const { return counts_.snapshot(); }
 
 }  // namespace posed::drivers

@@ -73,9 +73,7 @@ class SerialSource final : public Source {
   std::uint32_t reopen_attempts_ = 0;
   std::array<std::byte, 4096> buffer_{};
 
-  std::atomic<std::uint64_t> chunks_{0};
-  std::atomic<std::uint64_t> bytes_{0};
-  std::atomic<std::uint64_t> reopened_{0};
+  AtomicSourceCounters counts_;
 };
 
 }  // namespace posed::drivers

@@ -121,7 +121,7 @@ ReadStatus SocketCanSource::read(RawChunk& chunk, Duration timeout) {
         next_reopen_ = host_now() + backoff_;
         return ReadStatus::kDeviceLost;
       }
-      reopened_.fetch_add(1, std::memory_order_relaxed);
+      counts_.reopened.fetch_add(1, std::memory_order_relaxed);
       POSED_LOG_NOTICE("%s: CAN interface %s back", config_.name.c_str(),
                        config_.interface.c_str());
     }
@@ -157,8 +157,7 @@ ReadStatus SocketCanSource::read(RawChunk& chunk, Duration timeout) {
     chunk.bytes = std::as_bytes(std::span<const std::uint8_t>(buffer_.data(), size));
     chunk.host_receive = received;
     chunk.channel = 0;
-    chunks_.fetch_add(1, std::memory_order_relaxed);
-    bytes_.fetch_add(size, std::memory_order_relaxed);
+    counts_.count_chunk(size);
     return ReadStatus::kData;
   }
 }
@@ -171,13 +170,7 @@ void SocketCanSource::request_stop() {
   }
 }
 
-SourceCounters SocketCanSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters SocketCanSource::counters() const { return counts_.snapshot(); }
 
 SocketCanCounters SocketCanSource::can_counters() const {
   return {error_frames_.load(std::memory_order_relaxed), bus_off_.load(std::memory_order_relaxed)};

@@ -75,7 +75,8 @@ class SocketCanSource final : public Source {
   HostTime next_reopen_;
   Duration backoff_;
   std::array<std::uint8_t, kCanFdMtu> buffer_{};
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, reopened_{0}, error_frames_{0}, bus_off_{0};
+  AtomicSourceCounters counts_;
+  std::atomic<std::uint64_t> error_frames_{0}, bus_off_{0};
 };
 
 }  // namespace posed::drivers::can

@@ -154,8 +154,7 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
     chunk.channel = channels_[pending_.channel->id].source_channel;
   }
   have_pending_ = false;
-  chunks_.fetch_add(1, std::memory_order_relaxed);
-  bytes_.fetch_add(chunk.bytes.size(), std::memory_order_relaxed);
+  counts_.count_chunk(chunk.bytes.size());
   return ReadStatus::kData;
 }
 
@@ -165,12 +164,7 @@ void McapReplaySource::request_stop() {
   wait_cv_.notify_all();
 }
 
-SourceCounters McapReplaySource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters McapReplaySource::counters() const { return counts_.snapshot(); }
 
 std::string_view McapReplaySource::wire_format(std::uint32_t channel) const {
   std::lock_guard lock(info_mutex_);

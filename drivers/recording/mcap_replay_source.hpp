@@ -102,7 +102,7 @@ class McapReplaySource final : public Source {
   std::atomic<bool> stop_{false};
   std::mutex wait_mutex_;
   std::condition_variable wait_cv_;
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0};
+  AtomicSourceCounters counts_;
   mutable std::mutex info_mutex_;
   std::string damage_;
   std::map<std::uint16_t, ReplayChannel> channels_;

@@ -44,7 +44,7 @@ bool PcapSource::fetch_next() {
     records_.fetch_add(1, std::memory_order_relaxed);
     const FrameStatus f = extract_udp(record_.link_type, record_.frame, datagram_);
     if (f == FrameStatus::kTruncated || f == FrameStatus::kMalformed) {
-      rejected_.fetch_add(1, std::memory_order_relaxed);
+      counts_.rejected.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
     if (f != FrameStatus::kOk) {
@@ -96,8 +96,7 @@ ReadStatus PcapSource::read(RawChunk& chunk, Duration timeout) {
   chunk.bytes = datagram_.payload;
   chunk.host_receive = HostTime::from_ns(record_.timestamp_ns);
   chunk.channel = channel_;
-  chunks_.fetch_add(1, std::memory_order_relaxed);
-  bytes_.fetch_add(datagram_.payload.size(), std::memory_order_relaxed);
+  counts_.count_chunk(datagram_.payload.size());
   return ReadStatus::kData;
 }
 
@@ -109,20 +108,14 @@ void PcapSource::request_stop() {
   wait_cv_.notify_all();
 }
 
-SourceCounters PcapSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.rejected = rejected_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters PcapSource::counters() const { return counts_.snapshot(); }
 
 PcapSourceStats PcapSource::stats() const {
   PcapSourceStats s;
   s.records = records_.load(std::memory_order_relaxed);
   s.not_udp = not_udp_.load(std::memory_order_relaxed);
   s.other_ports = other_ports_.load(std::memory_order_relaxed);
-  s.damaged = rejected_.load(std::memory_order_relaxed);
+  s.damaged = counts_.rejected.load(std::memory_order_relaxed);
   return s;
 }
 

@@ -84,7 +84,7 @@ class PcapSource final : public drivers::Source {
   std::mutex wait_mutex_;
   std::condition_variable wait_cv_;
 
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, rejected_{0};
+  AtomicSourceCounters counts_;
   std::atomic<std::uint64_t> records_{0}, not_udp_{0}, other_ports_{0};
   mutable std::mutex error_mutex_;
   std::string file_error_;

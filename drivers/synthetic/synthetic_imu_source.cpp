@@ -65,18 +65,13 @@ ReadStatus SyntheticImuSource::read(RawChunk& chunk, Duration timeout) {
   const std::size_t n = a9::encode_a9_sensor_frame(frame, frame_);
 
   ++index_;
-  chunks_.fetch_add(1, std::memory_order_relaxed);
+  counts_.count_chunk(n);
   chunk.bytes = std::as_bytes(std::span<const std::uint8_t>(frame_.data(), n));
   chunk.host_receive = receive;
   chunk.channel = 0;
   return ReadStatus::kData;
 }
 
-SourceCounters SyntheticImuSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = c.chunks * a9::kSensorFrameSize;
-  return c;
-}
+SourceCounters SyntheticImuSource::counters() const { return counts_.snapshot(); }
 
 }  // namespace posed::drivers

@@ -66,7 +66,7 @@ class SyntheticImuSource final : public Source {
   std::int64_t period_ns_ = 0;
   std::uint64_t index_ = 0;
   std::vector<std::uint8_t> frame_;
-  std::atomic<std::uint64_t> chunks_{0};
+  AtomicSourceCounters counts_;
 };
 
 }  // namespace posed::drivers

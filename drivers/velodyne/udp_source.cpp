@@ -158,20 +158,19 @@ bool UdpSource::next_pending(RawChunk& chunk) {
       if (filter_sender_ &&
           (sender->sin_family != AF_INET || sender->sin_addr.s_addr != sensor_addr_be_)) {
         foreign_.fetch_add(1, std::memory_order_relaxed);
-        rejected_.fetch_add(1, std::memory_order_relaxed);
+        counts_.rejected.fetch_add(1, std::memory_order_relaxed);
         continue;
       }
       if ((m.msg_hdr.msg_flags & MSG_TRUNC) != 0 || m.msg_len > kSlotBytes) {
         oversized_.fetch_add(1, std::memory_order_relaxed);
-        rejected_.fetch_add(1, std::memory_order_relaxed);
+        counts_.rejected.fetch_add(1, std::memory_order_relaxed);
         continue;
       }
       chunk.bytes =
           std::span<const std::byte>(slots_[c].data() + std::size_t{i} * kSlotBytes, m.msg_len);
       chunk.host_receive = batch_time_[c];
       chunk.channel = static_cast<std::uint32_t>(c);
-      chunks_.fetch_add(1, std::memory_order_relaxed);
-      bytes_.fetch_add(m.msg_len, std::memory_order_relaxed);
+      counts_.count_chunk(m.msg_len);
       next_channel_ = (c + 1) % kChannels;
       return true;
     }
@@ -190,7 +189,7 @@ ReadStatus UdpSource::read(RawChunk& chunk, Duration timeout) {
       ::poll(&p, stop_fd_ >= 0 ? 1 : 0, static_cast<int>(timeout.ns / 1'000'000));
       return stop_.load() ? ReadStatus::kEndOfStream : ReadStatus::kDeviceLost;
     }
-    if (ever_opened_) reopened_.fetch_add(1, std::memory_order_relaxed);
+    if (ever_opened_) counts_.reopened.fetch_add(1, std::memory_order_relaxed);
   }
   const HostTime deadline = host_now() + timeout;
   for (;;) {
@@ -248,14 +247,7 @@ void UdpSource::request_stop() {
   }
 }
 
-SourceCounters UdpSource::counters() const {
-  SourceCounters c;
-  c.chunks = chunks_.load(std::memory_order_relaxed);
-  c.bytes = bytes_.load(std::memory_order_relaxed);
-  c.rejected = rejected_.load(std::memory_order_relaxed);
-  c.reopened = reopened_.load(std::memory_order_relaxed);
-  return c;
-}
+SourceCounters UdpSource::counters() const { return counts_.snapshot(); }
 
 UdpSourceStats UdpSource::stats() const {
   UdpSourceStats s;

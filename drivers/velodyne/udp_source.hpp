@@ -106,7 +106,7 @@ class UdpSource final : public drivers::Source {
   bool flowing_ = false;
 
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> chunks_{0}, bytes_{0}, rejected_{0}, reopened_{0};
+  AtomicSourceCounters counts_;
   std::atomic<std::uint64_t> foreign_{0}, oversized_{0}, silences_{0}, rcvbuf_{0};
 };
 
