@@ -23,6 +23,7 @@ Plane face_plane(const Box& b, std::uint8_t face) {
 PixelRays::PixelRays(const CameraIntrinsics& K, int downscale) {
   width_ = K.width / downscale;
   height_ = K.height / downscale;
+  pixel_angle_rad_ = downscale / std::sqrt(K.fx * K.fy);
   dirs_.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {

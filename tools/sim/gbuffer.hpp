@@ -65,6 +65,8 @@ class PixelRays {
   PixelRays(const CameraIntrinsics& intrinsics, int downscale);
   int width() const { return width_; }
   int height() const { return height_; }
+  /// angular pitch of one (downscaled) pixel at the image centre [rad]
+  double pixel_angle_rad() const { return pixel_angle_rad_; }
   const Eigen::Vector3d& dir(int x, int y) const {
     return dirs_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
                  static_cast<std::size_t>(x)];
@@ -72,6 +74,7 @@ class PixelRays {
 
  private:
   int width_ = 0, height_ = 0;
+  double pixel_angle_rad_ = 0;
   std::vector<Eigen::Vector3d> dirs_;
 };
 

@@ -68,11 +68,14 @@ void ThermalCamera::render_temperatures(Duration t) {
         const Material& m = world.materials[b.material];
         T = m.temperature_c;
         if (m.texture != kTexturePlain) {
-          const Eigen::Vector3d p =
-              o + static_cast<double>(gbuffer_.t_m[i]) * (R * rays_.dir(x, y));
-          T += (texture_value(m.texture, face_uv_m(b, gbuffer_.face[i], p),
-                              static_cast<std::uint32_t>(gbuffer_.box[i])) -
-                0.5);
+          const Eigen::Vector3d d = R * rays_.dir(x, y);
+          const auto range_m = static_cast<double>(gbuffer_.t_m[i]);
+          const Eigen::Vector3d p = o + range_m * d;
+          T += texture_value(
+                   m.texture, face_uv_m(b, gbuffer_.face[i], p),
+                   static_cast<std::uint32_t>(gbuffer_.box[i]),
+                   pixel_footprint(b, gbuffer_.face[i], d, range_m, rays_.pixel_angle_rad())) -
+               0.5;
         }
       }
       temperature_[i] = static_cast<float>(T);

@@ -137,9 +137,12 @@ void VisibleCamera::emit(std::vector<std::byte>& out) {
     const Material& m = world.materials[b.material];
     auto albedo = static_cast<float>(m.albedo);
     if (m.texture != kTexturePlain) {
-      const Eigen::Vector3d p = o + static_cast<double>(gbuffer_.t_m[i]) * (R * rays_.dir(x, y));
-      const double tv = texture_value(m.texture, face_uv_m(b, gbuffer_.face[i], p),
-                                      static_cast<std::uint32_t>(box));
+      const Eigen::Vector3d d = R * rays_.dir(x, y);
+      const auto t = static_cast<double>(gbuffer_.t_m[i]);
+      const Eigen::Vector3d p = o + t * d;
+      const double tv = texture_value(
+          m.texture, face_uv_m(b, gbuffer_.face[i], p), static_cast<std::uint32_t>(box),
+          pixel_footprint(b, gbuffer_.face[i], d, t, rays_.pixel_angle_rad()));
       albedo *= static_cast<float>(std::max(0.0, 1.0 + m.texture_contrast * 2.0 * (tv - 0.5)));
     }
     const float E = irradiance_[i];

@@ -112,29 +112,103 @@ double value_noise(const Eigen::Vector2d& uv, double per_m, std::uint32_t seed) 
 
 }  // namespace
 
-double texture_value(std::uint8_t texture, const Eigen::Vector2d& uv_m, std::uint32_t seed) {
+TextureFootprint pixel_footprint(const Box& box, std::uint8_t face, const Eigen::Vector3d& dir_map,
+                                 double range_m, double pixel_angle_rad) {
+  const int axis = face / 2;
+  const int ua = axis == 0 ? 1 : 0;
+  const int va = axis == 2 ? 1 : 2;
+  // A ray tilted by theta from the normal towards an in-plane axis e spreads the pixel along e by
+  // 1/cos(theta) = sqrt(1 + tan^2): tan = (e.d)/(n.d). Grazing rays are capped at 1/0.02.
+  const double n_d = std::max(std::abs(box.R_map_box.col(axis).dot(dir_map)), 0.02);
+  const double tan_u = box.R_map_box.col(ua).dot(dir_map) / n_d;
+  const double tan_v = box.R_map_box.col(va).dot(dir_map) / n_d;
+  const double pitch_m = range_m * pixel_angle_rad;
+  return {pitch_m * std::sqrt(1.0 + tan_u * tan_u), pitch_m * std::sqrt(1.0 + tan_v * tan_v)};
+}
+
+namespace {
+
+/// Integral from 0 to x of a periodic pulse that is 1 on [0, duty) of each period of 1.
+inline double pulse_integral(double x, double duty) {
+  const double cell = std::floor(x);
+  return cell * duty + std::min(x - cell, duty);
+}
+
+/// The pulse (period 1, 1 on [0, duty)) averaged over [x - w/2, x + w/2]; point sample for a
+/// footprint far below the period.
+inline double pulse_box(double x, double duty, double w) {
+  if (w < 1e-4) return x - std::floor(x) < duty ? 1.0 : 0.0;
+  return (pulse_integral(x + 0.5 * w, duty) - pulse_integral(x - 0.5 * w, duty)) / w;
+}
+
+/// How much of a random pattern of `cell`-sized cells survives averaging over a footprint: the
+/// standard deviation of the mean of the (u/cell)(v/cell) cells it covers, relative to one.
+inline double fade(double cell, const TextureFootprint& f) {
+  return std::sqrt(std::min(1.0, cell / std::max(f.u_m, 1e-9)) *
+                   std::min(1.0, cell / std::max(f.v_m, 1e-9)));
+}
+
+}  // namespace
+
+double texture_value(std::uint8_t texture, const Eigen::Vector2d& uv_m, std::uint32_t seed,
+                     const TextureFootprint& f) {
   switch (texture) {
     case kTextureNoise:
-      // blotches of 0.35 m and grain of 0.07 m
-      return 0.6 * value_noise(uv_m, 1.0 / 0.35, seed) +
-             0.4 * value_noise(uv_m, 1.0 / 0.07, seed + 1);
+      return 0.5 + 0.6 * fade(0.35, f) * (value_noise(uv_m, 1.0 / 0.35, seed) - 0.5) +
+             0.4 * fade(0.07, f) * (value_noise(uv_m, 1.0 / 0.07, seed + 1) - 0.5);
     case kTextureBricks: {
-      const double rows = uv_m.y() / 0.075;
+      constexpr double kRow = 0.075, kBrick = 0.25;
+      const double rows = uv_m.y() / kRow;
       const std::int32_t row = floor_i(rows);
-      const double x = uv_m.x() / 0.25 + ((row & 1) != 0 ? 0.5 : 0.0);
-      const std::int32_t column = floor_i(x);
-      const double fx = x - column, fy = rows - row;
-      if (fx < 0.04 || fy < 0.13) return 0.9;  // mortar
-      return 0.2 + 0.3 * hash01(column, row, seed);
+      const double x = uv_m.x() / kBrick + ((row & 1) != 0 ? 0.5 : 0.0);
+      const double half_u = 0.5 * f.u_m / kBrick, half_v = 0.5 * f.v_m / kRow;
+      // Bed joints (13 % of a course): exact. Head joints (4 % of a brick): exact over the part
+      // of the footprint in this course and in the neighbouring ones, whose joints are staggered
+      // by half a brick; their mean beyond a course.
+      const double bed = pulse_box(rows, 0.13, 2 * half_v);
+      double head = 0.04;
+      if (half_v < 1) {
+        const double in_row =
+            half_v < 1e-9
+                ? 1.0
+                : (std::min(rows + half_v, row + 1.0) - std::max(rows - half_v, 1.0 * row)) /
+                      (2 * half_v);
+        head = in_row * pulse_box(x, 0.04, 2 * half_u) +
+               (1 - in_row) * pulse_box(x + 0.5, 0.04, 2 * half_u);
+      }
+      const double mortar = 1 - (1 - bed) * (1 - head);
+      // Brick colours: this course's bricks weighted by their share of the footprint, fading to
+      // the mean as the footprint covers many.
+      const std::int32_t first = floor_i(x - half_u), last = floor_i(x + half_u);
+      double brick = 0.35;
+      if (last - first <= 1) {
+        // The brick faces (a cell minus its head joint) the footprint covers in this course.
+        const auto face = [&](std::int32_t c) {
+          if (half_u < 1e-9) return c == floor_i(x) ? 1.0 : 0.0;
+          return std::max(0.0, std::min(x + half_u, c + 1.0) - std::max(x - half_u, c + 0.04));
+        };
+        const double a_first = face(first), a_last = last == first ? 0.0 : face(last);
+        const double colour =
+            a_first + a_last > 0
+                ? (a_first * hash01(first, row, seed) + a_last * hash01(last, row, seed)) /
+                      (a_first + a_last)
+                : 0.5;
+        brick += fade(kRow, {0, f.v_m}) * 0.3 * (colour - 0.5);
+      } else {
+        brick += fade(kBrick, {f.u_m, f.v_m * kBrick / kRow}) * 0.3 *
+                 (hash01(floor_i(x), row, seed) - 0.5);
+      }
+      return mortar * 0.9 + (1 - mortar) * brick;
     }
-    case kTextureStripes: {
-      const double f = uv_m.x() - std::floor(uv_m.x());
-      return f < 0.12 ? 1.0 : 0.0;
-    }
+    case kTextureStripes:
+      return pulse_box(uv_m.x(), 0.12, f.u_m);
     case kTextureChecker: {
-      const auto cx = static_cast<std::int64_t>(std::floor(uv_m.x() / 0.2));
-      const auto cy = static_cast<std::int64_t>(std::floor(uv_m.y() / 0.2));
-      return ((cx + cy) & 1) != 0 ? 1.0 : 0.0;
+      // +-1 square waves of period 0.4 m in u and v; the checker is their product, and a box
+      // filter of a product of functions of u and of v is the product of their filtered values.
+      const auto square = [](double x, double w) {
+        return 1.0 - 2.0 * pulse_box(x / 0.4, 0.5, w / 0.4);
+      };
+      return 0.5 * (1.0 - square(uv_m.x(), f.u_m) * square(uv_m.y(), f.v_m));
     }
     default:
       return 0.5;

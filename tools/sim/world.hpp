@@ -158,7 +158,25 @@ inline Eigen::Vector3d face_normal_map(const Box& box, std::uint8_t face) {
 /// Texture coordinates of a map point on a face, in metres along the face's two axes.
 Eigen::Vector2d face_uv_m(const Box& box, std::uint8_t face, const Eigen::Vector3d& p_map_m);
 
-/// Texture value at face coordinates: 1 = mortar/dark line .. the pattern's range [0..1].
-double texture_value(std::uint8_t texture, const Eigen::Vector2d& uv_m, std::uint32_t seed);
+/// What one pixel sees of a face: the extent of its footprint along the face's u and v axes.
+struct TextureFootprint {
+  double u_m = 0;  ///< [m]
+  double v_m = 0;  ///< [m]
+};
+
+/// The footprint on `face` of a pixel of angular pitch `pixel_angle_rad` whose ray (unit
+/// `dir_map`) hits the face at range `range_m`: range x pitch, stretched by 1/cos of the
+/// incidence along the axis the ray slants across (a wall seen at a grazing angle).
+TextureFootprint pixel_footprint(const Box& box, std::uint8_t face, const Eigen::Vector3d& dir_map,
+                                 double range_m, double pixel_angle_rad);
+
+/// The texture averaged over a pixel's footprint (a box filter, analytic for the stripes, the
+/// checkerboard and the mortar lines; value noise and brick colours fade to their mean as more
+/// cells fall into the footprint). A camera that point-samples a pattern finer than its pixels
+/// renders moiré that no real lens and sensor produce, and a tracker locks onto it; the real
+/// camera integrates the light over the pixel. A zero footprint is the point sample.
+/// 1 = mortar/dark line .. the pattern's range [0..1].
+double texture_value(std::uint8_t texture, const Eigen::Vector2d& uv_m, std::uint32_t seed,
+                     const TextureFootprint& footprint = {});
 
 }  // namespace posed::sim
