@@ -1,10 +1,6 @@
 #include "drivers/recording/mcap_reader.hpp"
 
-#include <fcntl.h>
 #include <lz4frame.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <zstd.h>
 
 #include <cerrno>
@@ -77,14 +73,6 @@ bool read_string_map(In& in, std::map<std::string, std::string>& out) {
 
 }  // namespace
 
-struct McapReader::Mapping {
-  void* addr = nullptr;
-  std::size_t size = 0;
-  ~Mapping() {
-    if (addr != nullptr) ::munmap(addr, size);
-  }
-};
-
 McapReader::McapReader() = default;
 
 McapReader::~McapReader() {
@@ -95,33 +83,8 @@ McapReader::~McapReader() {
 bool McapReader::open(const std::string& path, std::string& error, McapReaderOptions options) {
   path_ = path;
   options_ = options;
-  mapping_.reset();
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    error = "mcap " + path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    error = "mcap " + path + ": fstat: " + std::strerror(errno);
-    ::close(fd);
-    return false;
-  }
-  auto m = std::make_unique<Mapping>();
-  m->size = static_cast<std::size_t>(st.st_size);
-  if (m->size > 0) {
-    m->addr = ::mmap(nullptr, m->size, PROT_READ, MAP_PRIVATE, fd, 0);
-    if (m->addr == MAP_FAILED) {
-      m->addr = nullptr;
-      error = "mcap " + path + ": mmap: " + std::strerror(errno);
-      ::close(fd);
-      return false;
-    }
-    ::madvise(m->addr, m->size, MADV_SEQUENTIAL);
-  }
-  ::close(fd);
-  file_ = {static_cast<const std::byte*>(m->addr), m->size};
-  mapping_ = std::move(m);
+  if (!mapped_.open(path, error, "mcap")) return false;
+  file_ = mapped_.bytes();
   return open_common(error);
 }
 
@@ -129,7 +92,7 @@ bool McapReader::open_bytes(std::span<const std::byte> bytes, std::string& error
                             McapReaderOptions options) {
   path_ = "<memory>";
   options_ = options;
-  mapping_.reset();
+  mapped_.close();
   file_ = bytes;
   return open_common(error);
 }

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "drivers/recording/crc32.hpp"
+#include "drivers/recording/mapped_file.hpp"
 
 namespace posed::drivers::recording {
 
@@ -161,8 +162,7 @@ class McapReader {
   bool next_in_chunk(McapMessage& out);
   bool decode_message(std::span<const std::byte> body, std::uint64_t offset, McapMessage& out);
 
-  struct Mapping;
-  std::unique_ptr<Mapping> mapping_;
+  MappedFile mapped_;
   std::span<const std::byte> file_;
   std::string path_;
   McapReaderOptions options_;

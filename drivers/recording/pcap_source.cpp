@@ -16,7 +16,7 @@ bool PcapSource::open(std::string& error) {
     error = "pcap " + config_.path + ": speed must be ≥ 0 (0 = as fast as possible)";
     return false;
   }
-  if (!file_.open(config_.path, error)) return false;
+  if (!file_.open(config_.path, error, "pcap")) return false;
   parser_ = PcapParser(file_.bytes());
   const PcapStatus s = parser_.open();
   if (s != PcapStatus::kOk) {

@@ -12,7 +12,7 @@
 
 #include "drivers/common/source.hpp"
 #include "drivers/common/wire_format.hpp"
-#include "drivers/recording/pcap_file.hpp"
+#include "drivers/recording/mapped_file.hpp"
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_udp.hpp"
 
@@ -64,7 +64,7 @@ class PcapSource final : public drivers::Source {
   bool fetch_next();  // fills next_ with the next datagram on one of our ports
 
   PcapSourceConfig config_;
-  PcapFile file_;
+  MappedFile file_;
   PcapParser parser_{{}};
   bool opened_ = false;
   bool ended_ = false;

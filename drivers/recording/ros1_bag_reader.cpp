@@ -1,10 +1,5 @@
 #include "drivers/recording/ros1_bag_reader.hpp"
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -53,47 +48,14 @@ std::string op_of(std::span<const std::byte> header) {
 
 }  // namespace
 
-struct BagReader::Mapping {
-  void* addr = nullptr;
-  std::size_t size = 0;
-  ~Mapping() {
-    if (addr != nullptr) ::munmap(addr, size);
-  }
-};
-
 BagReader::BagReader() = default;
 BagReader::~BagReader() = default;
 
 bool BagReader::open(const std::string& path, std::string& error, BagReaderOptions options) {
   path_ = path;
   options_ = std::move(options);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    error = "bag " + path + ": " + std::strerror(errno);
-    return false;
-  }
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    error = "bag " + path + ": fstat: " + std::strerror(errno);
-    ::close(fd);
-    return false;
-  }
-  auto m = std::make_unique<Mapping>();
-  m->size = static_cast<std::size_t>(st.st_size);
-  if (m->size > 0) {
-    m->addr = ::mmap(nullptr, m->size, PROT_READ, MAP_PRIVATE, fd, 0);
-    if (m->addr == MAP_FAILED) {
-      m->addr = nullptr;
-      error = "bag " + path + ": mmap: " + std::strerror(errno);
-      ::close(fd);
-      return false;
-    }
-    // Chunks are read front to back (indexed bags too, unless their chunks overlap in time).
-    ::madvise(m->addr, m->size, MADV_SEQUENTIAL);
-  }
-  ::close(fd);
-  mapping_ = std::move(m);
-  file_ = {static_cast<const std::byte*>(mapping_->addr), mapping_->size};
+  if (!mapped_.open(path, error, "bag")) return false;
+  file_ = mapped_.bytes();
   return open_common(error);
 }
 
@@ -101,6 +63,7 @@ bool BagReader::open_bytes(std::span<const std::byte> bytes, std::string& error,
                            BagReaderOptions options) {
   path_ = "(memory)";
   options_ = std::move(options);
+  mapped_.close();
   file_ = bytes;
   return open_common(error);
 }

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/recording/mapped_file.hpp"
 #include "drivers/recording/ros1_chunk.hpp"
 
 namespace posed::drivers::recording::ros1 {
@@ -134,7 +135,6 @@ class BagReader {
   std::uint32_t header_chunk_count() const { return header_chunk_count_; }
 
  private:
-  struct Mapping;
   struct IndexEntry {
     std::uint64_t time_ns = 0;
     std::uint32_t chunk = 0;   // index into chunks_
@@ -172,7 +172,7 @@ class BagReader {
   void stop(std::uint64_t offset, std::string what);
   void report_progress(std::uint64_t offset);
 
-  std::unique_ptr<Mapping> mapping_;
+  MappedFile mapped_;
   std::span<const std::byte> file_;
   std::string path_;
   BagReaderOptions options_;

@@ -9,9 +9,9 @@
 #include <map>
 #include <set>
 
+#include "drivers/recording/mapped_file.hpp"
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/mcap_replay_source.hpp"
-#include "drivers/recording/pcap_file.hpp"
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_udp.hpp"
 #include "drivers/recording/raw_channels.hpp"
@@ -63,9 +63,9 @@ std::string metadata_value(const std::string& path, const std::string& key) {
 TEST(Import, AVelodynePcapBecomesTheRawChannelsPosedRecordWrites) {
   POSED_REQUIRE_REALDATA(pcap, "velodyne_vlp32c/vlp32c_nebula_5scans.pcap");
   // What the capture holds, counted with the pcap reader itself.
-  rec::PcapFile file;
+  rec::MappedFile file;
   std::string error;
-  ASSERT_TRUE(file.open(pcap, error)) << error;
+  ASSERT_TRUE(file.open(pcap, error, "pcap")) << error;
   rec::PcapParser parser(file.bytes());
   ASSERT_EQ(parser.open(), rec::PcapStatus::kOk);
   std::vector<std::pair<std::int64_t, std::vector<std::byte>>> data_port;

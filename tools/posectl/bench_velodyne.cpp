@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/recording/pcap_file.hpp"
+#include "drivers/recording/mapped_file.hpp"
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_udp.hpp"
 #include "drivers/velodyne/device_clock.hpp"
@@ -38,9 +38,9 @@ std::vector<std::vector<std::byte>> real_packets() {
   std::vector<std::vector<std::byte>> out;
   for (const auto& base : bases) {
     const auto path = base / "velodyne_vlp32c/vlp32c_nebula_5scans.pcap";
-    drivers::recording::PcapFile file;
+    drivers::recording::MappedFile file;
     std::string error;
-    if (!std::filesystem::exists(path) || !file.open(path.string(), error)) continue;
+    if (!std::filesystem::exists(path) || !file.open(path.string(), error, "pcap")) continue;
     drivers::recording::PcapParser parser(file.bytes());
     if (parser.open() != drivers::recording::PcapStatus::kOk) continue;
     drivers::recording::PcapRecord rec;

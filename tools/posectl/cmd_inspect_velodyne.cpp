@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "drivers/recording/pcap_file.hpp"
+#include "drivers/recording/mapped_file.hpp"
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_udp.hpp"
 #include "drivers/velodyne/calibration_loader.hpp"
@@ -55,8 +55,8 @@ int run_inspect_velodyne(int argc, char** argv) {
     std::fprintf(stderr, "posectl inspect velodyne: %s\n", error.c_str());
     return 1;
   }
-  rec::PcapFile file;
-  if (!file.open(path, error)) {
+  rec::MappedFile file;
+  if (!file.open(path, error, "pcap")) {
     std::fprintf(stderr, "posectl inspect velodyne: %s\n", error.c_str());
     return 1;
   }

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/recording/pcap_file.hpp"
+#include "drivers/recording/mapped_file.hpp"
 #include "drivers/recording/pcap_parser.hpp"
 #include "drivers/recording/pcap_udp.hpp"
 
@@ -20,9 +20,9 @@ struct CapturedDatagram {
 
 inline std::vector<CapturedDatagram> load_datagrams(const std::string& path) {
   std::vector<CapturedDatagram> out;
-  drivers::recording::PcapFile file;
+  drivers::recording::MappedFile file;
   std::string error;
-  if (!file.open(path, error)) return out;
+  if (!file.open(path, error, "pcap")) return out;
   drivers::recording::PcapParser parser(file.bytes());
   if (parser.open() != drivers::recording::PcapStatus::kOk) return out;
   drivers::recording::PcapRecord rec;

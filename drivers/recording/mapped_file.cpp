@@ -1,4 +1,4 @@
-#include "drivers/recording/pcap_file.hpp"
+#include "drivers/recording/mapped_file.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -11,12 +11,12 @@
 
 namespace posed::drivers::recording {
 
-PcapFile::PcapFile(PcapFile&& o) noexcept
+MappedFile::MappedFile(MappedFile&& o) noexcept
     : data_(std::exchange(o.data_, nullptr)),
       size_(std::exchange(o.size_, 0)),
       path_(std::move(o.path_)) {}
 
-PcapFile& PcapFile::operator=(PcapFile&& o) noexcept {
+MappedFile& MappedFile::operator=(MappedFile&& o) noexcept {
   if (this != &o) {
     close();
     data_ = std::exchange(o.data_, nullptr);
@@ -26,9 +26,9 @@ PcapFile& PcapFile::operator=(PcapFile&& o) noexcept {
   return *this;
 }
 
-PcapFile::~PcapFile() { close(); }
+MappedFile::~MappedFile() { close(); }
 
-void PcapFile::close() {
+void MappedFile::close() {
   if (data_ != nullptr && size_ > 0) {
     ::munmap(const_cast<std::byte*>(data_), size_);
   }
@@ -36,29 +36,30 @@ void PcapFile::close() {
   size_ = 0;
 }
 
-bool PcapFile::open(const std::string& path, std::string& error) {
+bool MappedFile::open(const std::string& path, std::string& error, std::string_view kind) {
+  const std::string what = std::string(kind) + " " + path;
   close();
   path_ = path;
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
-    error = "pcap " + path + ": cannot open: " + std::strerror(errno);
+    error = what + ": cannot open: " + std::strerror(errno);
     return false;
   }
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
-    error = "pcap " + path + ": cannot stat: " + std::strerror(errno);
+    error = what + ": cannot stat: " + std::strerror(errno);
     ::close(fd);
     return false;
   }
   size_ = static_cast<std::size_t>(st.st_size);
-  if (size_ == 0) {  // mmap refuses length 0; an empty file is simply a truncated capture
+  if (size_ == 0) {  // mmap refuses length 0; the readers report an empty file as truncated
     ::close(fd);
     return true;
   }
   void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
   ::close(fd);
   if (p == MAP_FAILED) {
-    error = "pcap " + path + ": cannot map: " + std::strerror(errno);
+    error = what + ": cannot map: " + std::strerror(errno);
     size_ = 0;
     return false;
   }

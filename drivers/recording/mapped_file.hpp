@@ -1,0 +1,36 @@
+#pragma once
+// A file mapped read-only into memory, so the recording readers (MCAP, ROS 1 bags, pcap) parse
+// it in place without copies and the kernel pages it in as they walk it front to back. Owns the
+// mapping; movable, not copyable.
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace posed::drivers::recording {
+
+class MappedFile {
+ public:
+  MappedFile() = default;
+  MappedFile(MappedFile&& o) noexcept;
+  MappedFile& operator=(MappedFile&& o) noexcept;
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile();
+
+  /// Maps `path` (an empty file maps to no bytes). On failure returns false and sets `error`
+  /// ("KIND PATH: cannot open|stat|map: reason"), `kind` naming the format for the user.
+  bool open(const std::string& path, std::string& error, std::string_view kind = "file");
+  /// Unmaps; bytes() is empty afterwards.
+  void close();
+  std::span<const std::byte> bytes() const { return {data_, size_}; }
+  const std::string& path() const { return path_; }
+
+ private:
+  const std::byte* data_ = nullptr;
+  std::size_t size_ = 0;
+  std::string path_;
+};
+
+}  // namespace posed::drivers::recording
