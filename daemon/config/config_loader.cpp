@@ -340,7 +340,10 @@ class Loader {
     } else {
       for (std::size_t i = 0; i < fields->size(); ++i) {
         can::CanFieldMap entry;
-        if (parse_can_field((*fields)[i], key + ".fields[" + std::to_string(i) + "]", entry)) {
+        const std::string entry_key = key + ".fields[" + std::to_string(i) + "]";
+        const YAML::Mark mark = (*fields)[i].Mark();
+        places_[entry_key] = {mark.line + 1, mark.column + 1};
+        if (parse_can_field((*fields)[i], entry_key, entry)) {
           m.fields.push_back(entry);
         }
       }
@@ -532,6 +535,23 @@ void check_cross_field(const PosedConfig& c, std::string_view file, const Loader
     if (c.imu.can_interface.empty()) {
       errors.push_back({std::string(file), line, column, "imu.can_interface",
                         "imu.source is can but imu.can_interface is empty"});
+    }
+  }
+  // ClockSync unwraps a counter_us_32bit stamp at 2^32 µs; a narrower or scaled counter wraps
+  // elsewhere and would be read as clock jumps.
+  const auto& fields = c.imu.can_mapping.fields;
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const drivers::can::CanFieldMap& f = fields[i];
+    if (f.field != drivers::can::ImuField::kCounter || c.imu.clock_kind != "counter_us_32bit") {
+      continue;
+    }
+    if (f.type != drivers::can::FieldType::kU32 || f.scale != 1.0 || f.offset != 0.0) {
+      const std::string key = "imu.can_mapping.fields[" + std::to_string(i) + "]";
+      const auto [line, column] = loader.place_of(key);
+      errors.push_back({std::string(file), line, column, key,
+                        "imu.clock_kind counter_us_32bit needs a microsecond counter that wraps "
+                        "at 2^32 (type u32, scale 1, offset 0); for another counter set "
+                        "imu.clock_kind: none (samples stamped at arrival) or leave it unmapped"});
     }
   }
 }

@@ -346,6 +346,12 @@ TEST(ConfigCanImu, EachMistakeIsNamedWithItsLineAndKey) {
                       "imu.source is can but no imu.can_mapping");
   expect_single_error(load("imu:\n  can_mapping: [1, 2]\n"), "imu.can_mapping", 2,
                       "expected a mapping");
+  // A counter ClockSync would unwrap at the wrong place.
+  const std::string u16_counter =
+      with_line(7, "      - {id: 0x180, field: counter, byte: 0, type: u16, scale: 100}");
+  expect_single_error(load(u16_counter), "imu.can_mapping.fields[0]", 7,
+                      "needs a microsecond counter that wraps at 2^32");
+  EXPECT_TRUE(load(u16_counter + "  clock_kind: none\n").ok());
 }
 
 }  // namespace
