@@ -9,10 +9,15 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "daemon/config/config_schema.hpp"
 
@@ -41,6 +46,34 @@ std::string format_number(double v) {
   }
   return buf;
 }
+
+std::string hex_id(std::uint32_t id) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%X", id);
+  return buf;
+}
+
+}  // namespace
+
+std::string can_mapping_yaml(const drivers::can::CanImuMapping& m) {
+  if (m.fields.empty()) return "{}";
+  std::string s = "{complete_on_id: " + hex_id(m.complete_on_id) +
+                  ", complete_on_extended: " + (m.complete_on_extended ? "true" : "false") +
+                  ", fields: [";
+  for (std::size_t i = 0; i < m.fields.size(); ++i) {
+    const auto& f = m.fields[i];
+    s += std::string(i ? ", " : "") + "{id: " + hex_id(f.can_id) +
+         ", extended: " + (f.extended ? "true" : "false") +
+         ", field: " + std::string(drivers::can::to_string(f.field)) +
+         ", byte: " + std::to_string(f.byte_offset) +
+         ", type: " + std::string(drivers::can::to_string(f.type)) +
+         ", byte_order: " + (f.big_endian ? "motorola" : "intel") +
+         ", scale: " + format_number(f.scale) + ", offset: " + format_number(f.offset) + "}";
+  }
+  return s + "]}";
+}
+
+namespace {
 
 std::string range_text(const Field& f) {
   std::string s = "[" + format_number(f.min) + ", " + format_number(f.max) + "]";
@@ -73,6 +106,8 @@ class Loader {
       }
       const std::string key = prefix.empty() ? key_node.Scalar() : prefix + "." + key_node.Scalar();
       if (const Field* field = find_field(key)) {
+        const YAML::Mark mark = key_node.Mark();
+        places_[key] = {mark.line + 1, mark.column + 1};
         apply(*field, value);
       } else if (value.IsMap() && is_section(key)) {
         walk(value, key);
@@ -90,8 +125,15 @@ class Loader {
                    [&](std::string* out) { parse_string(field, value, *out); },
                    [&](Rotation3* out) { parse_matrix(field, value, *out, 3); },
                    [&](Transform4* out) { parse_matrix(field, value, *out, 4); },
+                   [&](drivers::can::CanImuMapping* out) { parse_can_mapping(field, value, *out); },
                },
                field.ref(config_));
+  }
+
+  /// Where a key was set in the file (line and column, 1-based), for checks across keys.
+  std::pair<int, int> place_of(const std::string& key) const {
+    const auto it = places_.find(key);
+    return it == places_.end() ? std::pair<int, int>{0, 0} : it->second;
   }
 
  private:
@@ -251,16 +293,266 @@ class Loader {
     out = m;
   }
 
+  // imu.can_mapping (config/imu-can-example.yaml):
+  //   can_mapping:
+  //     complete_on_id: 0x182        # the frame that completes a sample
+  //     complete_on_extended: false  # optional: inferred from the fields with that ID
+  //     fields:
+  //       - {id: 0x181, field: gyro_x, byte: 0, type: i16, byte_order: intel, scale: 1.0e-3}
+  // Each problem is reported at its own node with a key such as imu.can_mapping.fields[2].type;
+  // a mapping that parses is then checked by the decoder's own validate().
+  void parse_can_mapping(const Field& f, const YAML::Node& v, drivers::can::CanImuMapping& out) {
+    namespace can = drivers::can;
+    const std::string key(f.key);
+    if (v.IsNull() || (v.IsMap() && v.size() == 0)) {
+      out = {};
+      return;
+    }
+    if (!v.IsMap()) {
+      error(v, key,
+            std::string("expected a mapping {complete_on_id, fields: [...]}, found a ") +
+                (v.IsSequence() ? "list" : "plain value"));
+      return;
+    }
+    const std::size_t errors_before = errors_.size();
+    // optional, not bare Nodes: assigning to a yaml-cpp Node writes into the node it refers to.
+    std::optional<YAML::Node> fields, complete_id, complete_extended;
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      const YAML::Node name = it->first;
+      const YAML::Node value = it->second;
+      const std::string n = name.IsScalar() ? name.Scalar() : std::string();
+      if (n == "fields") {
+        fields.emplace(value);
+      } else if (n == "complete_on_id") {
+        complete_id.emplace(value);
+      } else if (n == "complete_on_extended") {
+        complete_extended.emplace(value);
+      } else {
+        error(name, key + "." + n,
+              "unknown key (a CAN mapping has fields, complete_on_id, complete_on_extended)");
+      }
+    }
+    can::CanImuMapping m;
+    if (!fields) {
+      error(v, key + ".fields", "missing: the list of mapped fields");
+    } else if (!fields->IsSequence() || fields->size() == 0) {
+      error(*fields, key + ".fields", "expected a non-empty list of {id, field, byte, type, ...}");
+    } else {
+      for (std::size_t i = 0; i < fields->size(); ++i) {
+        can::CanFieldMap entry;
+        const std::string entry_key = key + ".fields[" + std::to_string(i) + "]";
+        const YAML::Mark mark = (*fields)[i].Mark();
+        places_[entry_key] = {mark.line + 1, mark.column + 1};
+        if (parse_can_field((*fields)[i], entry_key, entry)) {
+          m.fields.push_back(entry);
+        }
+      }
+    }
+    if (!complete_id) {
+      error(v, key + ".complete_on_id", "missing: the ID of the frame that completes a sample");
+    } else {
+      parse_can_id(*complete_id, key + ".complete_on_id", true, m.complete_on_id);
+    }
+    if (complete_extended) {
+      parse_flag(*complete_extended, key + ".complete_on_extended", m.complete_on_extended);
+    } else {
+      // Inferred: extended when the mapped frames with that number are all 29-bit ones.
+      bool standard = false, extended = false;
+      for (const auto& e : m.fields) {
+        if (e.can_id != m.complete_on_id) continue;
+        (e.extended ? extended : standard) = true;
+      }
+      m.complete_on_extended = extended && !standard;
+    }
+    if (errors_.size() != errors_before) return;
+    std::string why;
+    std::size_t bad = std::string::npos;
+    if (!can::validate(m, why, bad)) {
+      if (bad < fields->size()) {
+        error((*fields)[bad], key + ".fields[" + std::to_string(bad) + "]", why);
+      } else if (why.find("complete_on_id") != std::string::npos) {
+        error(*complete_id, key + ".complete_on_id", why);
+      } else {
+        error(*fields, key + ".fields", why);
+      }
+      return;
+    }
+    out = std::move(m);
+  }
+
+  bool parse_can_field(const YAML::Node& v, const std::string& key,
+                       drivers::can::CanFieldMap& out) {
+    namespace can = drivers::can;
+    if (!v.IsMap()) {
+      error(v, key, "expected a mapping {id, field, byte, type, byte_order, scale, offset}");
+      return false;
+    }
+    const std::size_t errors_before = errors_.size();
+    std::optional<YAML::Node> id, extended, field, byte, type, order, scale, offset;
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      const YAML::Node name = it->first;
+      const YAML::Node value = it->second;
+      const std::string n = name.IsScalar() ? name.Scalar() : std::string();
+      std::optional<YAML::Node>* slot = n == "id"           ? &id
+                                        : n == "extended"   ? &extended
+                                        : n == "field"      ? &field
+                                        : n == "byte"       ? &byte
+                                        : n == "type"       ? &type
+                                        : n == "byte_order" ? &order
+                                        : n == "scale"      ? &scale
+                                        : n == "offset"     ? &offset
+                                                            : nullptr;
+      if (slot == nullptr) {
+        error(name, key + "." + n,
+              "unknown key (a mapped field has id, extended, field, byte, type, byte_order, "
+              "scale, offset)");
+      } else {
+        slot->emplace(value);
+      }
+    }
+    for (const auto& [node, name] : {std::pair{&id, "id"}, std::pair{&field, "field"},
+                                     std::pair{&byte, "byte"}, std::pair{&type, "type"}}) {
+      if (!*node) error(v, key + "." + name, "missing");
+    }
+    if (extended) parse_flag(*extended, key + ".extended", out.extended);
+    if (id) parse_can_id(*id, key + ".id", out.extended, out.can_id);
+    if (field && expect_text(*field, key + ".field")) {
+      if (const auto f = can::imu_field_from_string(field->Scalar())) {
+        out.field = *f;
+      } else {
+        error(*field, key + ".field",
+              "'" + field->Scalar() +
+                  "' is not one of: gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z,counter");
+      }
+    }
+    if (type && expect_text(*type, key + ".type")) {
+      if (const auto t = can::field_type_from_string(type->Scalar())) {
+        out.type = *t;
+      } else {
+        error(*type, key + ".type",
+              "'" + type->Scalar() + "' is not one of: u8,i8,u16,i16,u32,i32,f32");
+      }
+    }
+    double d = 0;
+    if (byte && parse_plain_number(*byte, key + ".byte", d)) {
+      if (d != std::floor(d) || d < 0 || d > 63) {
+        error(*byte, key + ".byte", "expected a byte offset 0..63, found '" + byte->Scalar() + "'");
+      } else {
+        out.byte_offset = static_cast<std::uint8_t>(d);
+      }
+    }
+    if (order && expect_text(*order, key + ".byte_order")) {
+      if (order->Scalar() == "intel") {
+        out.big_endian = false;
+      } else if (order->Scalar() == "motorola") {
+        out.big_endian = true;
+      } else {
+        error(*order, key + ".byte_order",
+              "'" + order->Scalar() + "' is not one of: intel,motorola (little, big endian)");
+      }
+    }
+    if (scale && parse_plain_number(*scale, key + ".scale", d)) {
+      if (d == 0) {
+        error(*scale, key + ".scale", "must not be 0");
+      } else {
+        out.scale = d;
+      }
+    }
+    if (offset && parse_plain_number(*offset, key + ".offset", d)) out.offset = d;
+    return errors_.size() == errors_before;
+  }
+
+  bool expect_text(const YAML::Node& v, const std::string& key) {
+    if (v.IsScalar()) return true;
+    error(v, key, "expected a name, found a " + std::string(v.IsMap() ? "mapping" : "list"));
+    return false;
+  }
+
+  bool parse_plain_number(const YAML::Node& v, const std::string& key, double& out) {
+    const std::string s = v.IsScalar() ? v.Scalar() : std::string();
+    char* end = nullptr;
+    out = std::strtod(s.c_str(), &end);
+    if (!v.IsScalar() || s.empty() || end != s.c_str() + s.size() || !std::isfinite(out)) {
+      error(v, key, "expected a number, found '" + s + "'");
+      return false;
+    }
+    return true;
+  }
+
+  void parse_flag(const YAML::Node& v, const std::string& key, bool& out) {
+    const std::string s = v.IsScalar() ? v.Scalar() : std::string();
+    if (s == "true" || s == "yes" || s == "on") {
+      out = true;
+    } else if (s == "false" || s == "no" || s == "off") {
+      out = false;
+    } else {
+      error(v, key, "expected true or false, found '" + s + "'");
+    }
+  }
+
+  // An arbitration ID, decimal or 0x hex: 11 bits, or 29 bits when `extended`.
+  void parse_can_id(const YAML::Node& v, const std::string& key, bool extended,
+                    std::uint32_t& out) {
+    const std::string s = v.IsScalar() ? v.Scalar() : std::string();
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long id = std::strtoull(s.c_str(), &end, 0);
+    if (!v.IsScalar() || s.empty() || s.front() == '-' || end != s.c_str() + s.size() ||
+        errno != 0) {
+      error(v, key, "expected a CAN ID (decimal or 0x hex), found '" + s + "'");
+      return;
+    }
+    const unsigned long long max = extended ? 0x1FFFFFFFull : 0x7FFull;
+    if (id > max) {
+      error(v, key,
+            s + " is out of range for " +
+                (extended ? std::string("a 29-bit ID (0..0x1FFFFFFF)")
+                          : std::string("an 11-bit ID (0..0x7FF; extended: true for 29 bits)")));
+      return;
+    }
+    out = static_cast<std::uint32_t>(id);
+  }
+
   std::string file_;
   PosedConfig& config_;
   std::vector<ConfigError>& errors_;
+  std::map<std::string, std::pair<int, int>> places_;
 };
 
-void check_cross_field(const PosedConfig& c, std::string_view file,
+void check_cross_field(const PosedConfig& c, std::string_view file, const Loader& loader,
                        std::vector<ConfigError>& errors) {
   if (c.lidar.min_range_m >= c.lidar.max_range_m) {
     errors.push_back(
         {std::string(file), 0, 0, "lidar.min_range_m", "must be below lidar.max_range_m"});
+  }
+  if (c.imu.source == "can") {
+    const auto [line, column] = loader.place_of("imu.source");
+    if (c.imu.can_mapping.fields.empty()) {
+      errors.push_back({std::string(file), line, column, "imu.can_mapping",
+                        "imu.source is can but no imu.can_mapping says which frames carry the "
+                        "IMU's fields (config/imu-can-example.yaml)"});
+    }
+    if (c.imu.can_interface.empty()) {
+      errors.push_back({std::string(file), line, column, "imu.can_interface",
+                        "imu.source is can but imu.can_interface is empty"});
+    }
+  }
+  // ClockSync unwraps a counter_us_32bit stamp at 2^32 µs; a narrower or scaled counter wraps
+  // elsewhere and would be read as clock jumps.
+  const auto& fields = c.imu.can_mapping.fields;
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const drivers::can::CanFieldMap& f = fields[i];
+    if (f.field != drivers::can::ImuField::kCounter || c.imu.clock_kind != "counter_us_32bit") {
+      continue;
+    }
+    if (f.type != drivers::can::FieldType::kU32 || f.scale != 1.0 || f.offset != 0.0) {
+      const std::string key = "imu.can_mapping.fields[" + std::to_string(i) + "]";
+      const auto [line, column] = loader.place_of(key);
+      errors.push_back({std::string(file), line, column, key,
+                        "imu.clock_kind counter_us_32bit needs a microsecond counter that wraps "
+                        "at 2^32 (type u32, scale 1, offset 0); for another counter set "
+                        "imu.clock_kind: none (samples stamped at arrival) or leave it unmapped"});
+    }
   }
 }
 
@@ -309,7 +601,7 @@ LoadResult load_config_text(std::string_view yaml_text, std::string_view name) {
   }
   Loader loader(name, result.config, result.errors);
   loader.walk(root, "");
-  if (result.errors.empty()) check_cross_field(result.config, name, result.errors);
+  if (result.errors.empty()) check_cross_field(result.config, name, loader, result.errors);
   return result;
 }
 
@@ -375,6 +667,7 @@ std::string print_config(const PosedConfig& config_in) {
                 s += (i ? ", " : "") + format_number((*m)[i]);
               return s + "]";
             },
+            [](drivers::can::CanImuMapping* m) { return can_mapping_yaml(*m); },
         },
         f.ref(config));
     std::string comment;

@@ -36,6 +36,10 @@ LoadResult load_config_file(const std::string& path);
 /// Same, from text; `name` stands for the file name in errors.
 LoadResult load_config_text(std::string_view yaml_text, std::string_view name);
 
+/// imu.can_mapping as one line of flow YAML that the loader reads back ("{}" for none), as
+/// --print-config and a recording's metadata show it.
+std::string can_mapping_yaml(const drivers::can::CanImuMapping& mapping);
+
 /// The effective configuration as YAML, every key with its unit, range and description.
 std::string print_config(const PosedConfig& config);
 

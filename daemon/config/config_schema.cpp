@@ -32,13 +32,22 @@ const Field kSchema[] = {
     F("publish.status_rate_hz", publish.status_rate_hz, "1", "Hz", 0.1, 100, "",
       "rt/posed/status rate"),
 
-    F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial",
-      "where IMU samples come from"),
+    F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial|can",
+      "where IMU samples come from: the synthetic circle, the A9 over serial, or an IMU on a "
+      "SocketCAN interface (imu.can_interface, imu.can_mapping)"),
     F("imu.rate_hz", imu.rate_hz, "150", "Hz", 1, 2000, "", "nominal IMU sample rate"),
     F("imu.serial_device", imu.serial_device, "/dev/posed-imu", "", 0, 0, "",
       "A9 serial port (path or /dev/serial/by-id/...)"),
     F("imu.serial_baud", imu.serial_baud, "921600", "baud", 9600, 4000000, "",
       "A9 serial baud rate"),
+    F("imu.can_interface", imu.can_interface, "can0", "", 0, 0, "",
+      "SocketCAN interface of a CAN IMU (imu.source can)"),
+    // A list, not a scalar: config_loader.cpp parses it and checks it with the decoder's own
+    // validate(); config/imu-can-example.yaml documents it.
+    F("imu.can_mapping", imu.can_mapping, "{}", "", 0, 0, "",
+      "which CAN frames carry which IMU field: {complete_on_id, fields: [{id, extended, field, "
+      "byte, type, byte_order, scale, offset}]}; used by imu.source can and to replay recorded "
+      "or imported CAN frames ({} = none)"),
     F("imu.R_imu_sensor", imu.R_imu_sensor, "[1, 0, 0, 0, 1, 0, 0, 0, 1]", "", 0, 0, "",
       "mounting rotation from the sensor's axes into the IMU frame (row-major 3x3)"),
     F("imu.gyro_noise_density", imu.gyro_noise_density, "2.3417543020438883e-03", "rad/s/sqrt(Hz)",

@@ -14,7 +14,8 @@
 namespace posed::config {
 
 /// Where a field lives in PosedConfig; the alternative also says the field's type.
-using FieldRef = std::variant<bool*, int*, double*, std::string*, Rotation3*, Transform4*>;
+using FieldRef = std::variant<bool*, int*, double*, std::string*, Rotation3*, Transform4*,
+                              drivers::can::CanImuMapping*>;
 
 struct Field {
   /// dotted path in the YAML file, e.g. "imu.rate_hz"

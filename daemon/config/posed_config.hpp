@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <string>
 
+#include "drivers/imu/can_imu_mapping.hpp"
+
 namespace posed::config {
 
 /// A 4x4 homogeneous transform, row-major: T_a_b maps points from frame b into frame a.
@@ -30,10 +32,14 @@ struct PublishSection {
 };
 
 struct ImuSection {
-  std::string source;                ///< synthetic | serial
-  double rate_hz = 150.0;            ///< nominal sample rate [Hz]
-  std::string serial_device;         ///< path or /dev/serial/by-id/... of the A9
-  int serial_baud = 921600;          ///< [baud]
+  std::string source;         ///< synthetic | serial | can
+  double rate_hz = 150.0;     ///< nominal sample rate [Hz]
+  std::string serial_device;  ///< path or /dev/serial/by-id/... of the A9
+  int serial_baud = 921600;   ///< [baud]
+  std::string can_interface;  ///< SocketCAN interface of a CAN IMU (can0, vcan0)
+  /// Which CAN frame carries which IMU field, at which byte, type and scale: read by a live CAN
+  /// IMU and by a replay of recorded or imported CAN frames. No fields = no mapping.
+  drivers::can::CanImuMapping can_mapping;
   Rotation3 R_imu_sensor{};          ///< mounting rotation, sensor axes into the IMU frame
   double gyro_noise_density = 0.0;   ///< [rad/s/sqrt(Hz)]
   double gyro_random_walk = 0.0;     ///< [rad/s^2/sqrt(Hz)]
@@ -75,15 +81,15 @@ struct LidarSection {
 
 struct CameraSection {
   bool enabled = false;
-  std::string device;                     ///< V4L2 path, /dev/v4l/by-id/..., or serial
-  std::string source;                     ///< v4l2 | aravis
-  std::string format;                     ///< wire pixel format (yuyv, y8, y16, mjpeg, ...)
+  std::string device;                         ///< V4L2 path, /dev/v4l/by-id/..., or serial
+  std::string source;                         ///< v4l2 | aravis
+  std::string format;                         ///< wire pixel format (yuyv, y8, y16, mjpeg, ...)
   std::string intrinsics_source = "factory";  ///< factory (D435i HW monitor) | config
-  int width = 0;                          ///< [px]
-  int height = 0;                         ///< [px]
-  double rate_hz = 0;                     ///< [Hz]
-  double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics [px]
-  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  ///< radial-tangential distortion
+  int width = 0;                              ///< [px]
+  int height = 0;                             ///< [px]
+  double rate_hz = 0;                         ///< [Hz]
+  double fx = 0, fy = 0, cx = 0, cy = 0;      ///< pinhole intrinsics [px]
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;      ///< radial-tangential distortion
   double latency_s = 0;    ///< least host arrival minus exposure midpoint of a frame [s]
   std::string clock_kind;  ///< hardware_ns (D435i metadata) | none (UVC thermal)
 };

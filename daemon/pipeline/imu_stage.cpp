@@ -29,6 +29,8 @@ ImuStage::ImuStage(const config::PosedConfig& config, drivers::Source& source,
       consumer_(consumer),
       heartbeat_(heartbeat),
       counters_(counters),
+      can_decoder_(config.imu.can_mapping),
+      can_mapped_(!config.imu.can_mapping.fields.empty()),
       mounting_(mounting_from(config.imu.R_imu_sensor)),
       clock_(ClockSyncConfig{.kind = clock_kind_from(config.imu.clock_kind),
                              .nominal_rate_hz = config.imu.source == "synthetic"
@@ -77,6 +79,11 @@ void ImuStage::run() {
     const std::string_view format = reader.wire_format(chunk);
     if (format == drivers::wire::kRos1Imu) {
       on_ros1_imu(chunk);
+      publish_progress();
+      continue;
+    }
+    if (format == drivers::wire::kCanFrame) {
+      on_can_frame(chunk);
       publish_progress();
       continue;
     }

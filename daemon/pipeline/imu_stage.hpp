@@ -1,7 +1,8 @@
 #pragma once
 // The IMU stage (one thread): Source -> decoder chosen by the channel's wire format -> ClockSync
 // (device stamp -> host clock) -> the IMU queue to the fusion stage. Wire formats: the A9's
-// serial frames, and sensor_msgs/Imu from an imported ROS 1 bag (imu_stage_ros1.cpp).
+// serial frames, sensor_msgs/Imu from an imported ROS 1 bag (imu_stage_ros1.cpp), and Linux CAN
+// frames decoded by imu.can_mapping (imu_stage_can.cpp).
 
 #include "core/spsc_queue.hpp"
 #include "core/sync/clock_sync.hpp"
@@ -10,6 +11,7 @@
 #include "daemon/pipeline/wakeup.hpp"
 #include "drivers/common/source.hpp"
 #include "drivers/imu/a9_protocol.hpp"
+#include "drivers/imu/can_imu_mapping.hpp"
 
 namespace posed::pipeline {
 
@@ -24,6 +26,9 @@ class ImuStage {
   void on_a9_frame(const drivers::a9::A9Frame& frame, HostTime arrival);
   /// One serialized sensor_msgs/Imu (imu_stage_ros1.cpp).
   void on_ros1_imu(const drivers::RawChunk& chunk);
+  /// One Linux struct can_frame/canfd_frame, decoded by imu.can_mapping (imu_stage_can.cpp).
+  void on_can_frame(const drivers::RawChunk& chunk);
+  void count_malformed_can(const char* what, std::size_t bytes);
   void push(const ImuSample& sample);
   void count_malformed();
   void publish_progress();
@@ -36,6 +41,10 @@ class ImuStage {
   StreamCounters& counters_;
 
   drivers::a9::A9Decoder a9_decoder_;
+  drivers::can::CanImuDecoder can_decoder_;
+  bool can_mapped_ = false;
+  bool can_unmapped_said_ = false;
+  bool can_clock_said_ = false;
   drivers::a9::A9Mounting mounting_;
   ClockSync clock_;
   std::uint64_t malformed_seen_ = 0;

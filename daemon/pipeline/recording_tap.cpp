@@ -48,7 +48,13 @@ std::map<std::string, std::string> recording_metadata(const config::PosedConfig&
   std::map<std::string, std::string> md{{"posed.config", config::print_config(config)}};
   if (stream == "imu") {
     md["posed.imu.source"] = config.imu.source;
-    md["posed.imu.device"] = config.imu.serial_device;
+    if (config.imu.source == "can") {
+      // The interface, and the mapping the frames were read with (also in posed.config).
+      md["posed.imu.device"] = config.imu.can_interface;
+      md["posed.imu.can_mapping"] = config::can_mapping_yaml(config.imu.can_mapping);
+    } else {
+      md["posed.imu.device"] = config.imu.serial_device;
+    }
   } else if (stream == "lidar") {
     md["posed.lidar.address"] = config.lidar.address;
     md["posed.lidar.calibration"] = config.lidar.calibration;

@@ -2,26 +2,17 @@
 
 #include <bit>
 #include <cstdio>
+#include <iterator>
 #include <utility>
 
 namespace posed::drivers::can {
 namespace {
 
-std::size_t type_size(FieldType t) {
-  switch (t) {
-    case FieldType::kU8:
-    case FieldType::kI8:
-      return 1;
-    case FieldType::kU16:
-    case FieldType::kI16:
-      return 2;
-    case FieldType::kU32:
-    case FieldType::kI32:
-    case FieldType::kF32:
-      return 4;
-  }
-  return 0;
-}
+constexpr std::string_view kFieldNames[] = {"gyro_x",  "gyro_y",  "gyro_z", "accel_x",
+                                            "accel_y", "accel_z", "counter"};
+constexpr std::string_view kTypeNames[] = {"u8", "i8", "u16", "i16", "u32", "i32", "f32"};
+
+std::size_t type_size(FieldType t) { return field_size(t); }
 
 double read_raw(const std::uint8_t* p, FieldType t, bool big_endian) {
   const std::size_t n = type_size(t);
@@ -52,10 +43,57 @@ constexpr std::uint32_t kSixAxes = 0x3Fu;
 
 }  // namespace
 
+std::string_view to_string(ImuField field) {
+  const auto i = static_cast<std::size_t>(field);
+  return i < std::size(kFieldNames) ? kFieldNames[i] : std::string_view("?");
+}
+
+std::string_view to_string(FieldType type) {
+  const auto i = static_cast<std::size_t>(type);
+  return i < std::size(kTypeNames) ? kTypeNames[i] : std::string_view("?");
+}
+
+std::optional<ImuField> imu_field_from_string(std::string_view name) {
+  for (std::size_t i = 0; i < std::size(kFieldNames); ++i) {
+    if (kFieldNames[i] == name) return static_cast<ImuField>(i);
+  }
+  return std::nullopt;
+}
+
+std::optional<FieldType> field_type_from_string(std::string_view name) {
+  for (std::size_t i = 0; i < std::size(kTypeNames); ++i) {
+    if (kTypeNames[i] == name) return static_cast<FieldType>(i);
+  }
+  return std::nullopt;
+}
+
+std::size_t field_size(FieldType type) {
+  switch (type) {
+    case FieldType::kU8:
+    case FieldType::kI8:
+      return 1;
+    case FieldType::kU16:
+    case FieldType::kI16:
+      return 2;
+    case FieldType::kU32:
+    case FieldType::kI32:
+    case FieldType::kF32:
+      return 4;
+  }
+  return 0;
+}
+
 bool validate(const CanImuMapping& mapping, std::string& error) {
+  std::size_t bad_field = 0;
+  return validate(mapping, error, bad_field);
+}
+
+bool validate(const CanImuMapping& mapping, std::string& error, std::size_t& bad_field) {
+  bad_field = std::string::npos;
   std::uint32_t seen = 0;
   bool completes = false;
   for (std::size_t i = 0; i < mapping.fields.size(); ++i) {
+    bad_field = i;
     const CanFieldMap& f = mapping.fields[i];
     const std::string where = "CAN IMU mapping field " + std::to_string(i) + " (ID 0x";
     char id[16];
@@ -66,15 +104,22 @@ bool validate(const CanImuMapping& mapping, std::string& error) {
       return false;
     }
     if ((seen & bit(f.field)) != 0) {
-      error = where + id + ": field " + std::to_string(static_cast<int>(f.field)) + " mapped twice";
+      error = where + id + ": field " + std::string(to_string(f.field)) + " mapped twice";
       return false;
     }
     seen |= bit(f.field);
     completes = completes ||
                 (f.can_id == mapping.complete_on_id && f.extended == mapping.complete_on_extended);
   }
+  bad_field = std::string::npos;
   if ((seen & kSixAxes) != kSixAxes) {
-    error = "CAN IMU mapping: gyro x/y/z and accel x/y/z must all be mapped";
+    std::string missing;
+    for (std::size_t f = 0; f < 6; ++f) {
+      if ((seen & (1u << f)) == 0)
+        missing += (missing.empty() ? "" : ", ") + std::string(kFieldNames[f]);
+    }
+    error =
+        "CAN IMU mapping: gyro x/y/z and accel x/y/z must all be mapped (missing: " + missing + ")";
     return false;
   }
   if (!completes) {

@@ -3,8 +3,11 @@
 // field, at which byte, in which type and byte order, with which scale to SI. Pure decoder.
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/measurements.hpp"
@@ -15,6 +18,14 @@ namespace posed::drivers::can {
 
 enum class ImuField : std::uint8_t { kGyroX, kGyroY, kGyroZ, kAccelX, kAccelY, kAccelZ, kCounter };
 enum class FieldType : std::uint8_t { kU8, kI8, kU16, kI16, kU32, kI32, kF32 };
+
+/// The names configuration files use: gyro_x .. accel_z, counter; u8 .. i32, f32.
+std::string_view to_string(ImuField field);
+std::string_view to_string(FieldType type);
+std::optional<ImuField> imu_field_from_string(std::string_view name);
+std::optional<FieldType> field_type_from_string(std::string_view name);
+/// Size of a field of `type` [B].
+std::size_t field_size(FieldType type);
 
 /// One field: value = raw · scale + offset.
 struct CanFieldMap {
@@ -45,6 +56,10 @@ struct CanImuMapping {
 /// Checks a mapping: each of the six gyro/accel fields exactly once, fields inside 64 bytes,
 /// completing ID among the mapped IDs. On failure says which field and why.
 bool validate(const CanImuMapping& mapping, std::string& error);
+/// The same; on failure `bad_field` is the index of the offending entry of `mapping.fields`, or
+/// npos when the problem is the mapping as a whole (an axis missing, the completing ID), so a
+/// config loader can point at the line.
+bool validate(const CanImuMapping& mapping, std::string& error, std::size_t& bad_field);
 
 /// One sample in the sensor's axes, SI.
 struct CanImuReading {

@@ -119,7 +119,7 @@ TEST(Config, FractionalInt) {
 
 TEST(Config, ChoiceNotAllowed) {
   const auto r = load("imu:\n  source: usb\n");
-  expect_single_error(r, "imu.source", 2, "'usb' is not one of: synthetic,serial");
+  expect_single_error(r, "imu.source", 2, "'usb' is not one of: synthetic,serial,can");
 }
 
 TEST(Config, MatrixWrongSize) {
@@ -202,7 +202,8 @@ TEST(Config, PrintedConfigLoadsBackIdentically) {
 TEST(Config, ShippedConfigsLoad) {
   const char* src = std::getenv("POSED_SOURCE_DIR");
   ASSERT_NE(src, nullptr) << "POSED_SOURCE_DIR is set by ctest";
-  for (const char* name : {"/config/posed.yaml", "/config/demo.yaml"}) {
+  for (const char* name :
+       {"/config/posed.yaml", "/config/demo.yaml", "/config/imu-can-example.yaml"}) {
     const auto r = load_config_file(std::string(src) + name);
     EXPECT_TRUE(r.ok()) << name << ":\n" << r.error_text();
   }
@@ -221,6 +222,136 @@ TEST(Config, RelativePathsResolveAgainstTheConfigFile) {
   ASSERT_TRUE(r.ok()) << r.error_text();
   EXPECT_EQ(r.config.dds.cyclonedds_config, std::string(src) + "/config/cyclonedds-loopback.xml");
   EXPECT_EQ(r.config.lidar.calibration, "");  // empty stays empty
+}
+
+}  // namespace
+}  // namespace posed::config
+
+// imu.can_mapping: a list of CAN fields, parsed at load and checked by the decoder's validate().
+namespace posed::config {
+namespace {
+
+const std::string kCanImu =
+    "imu:\n"                                                                         // 1
+    "  source: can\n"                                                                // 2
+    "  can_interface: vcan0\n"                                                       // 3
+    "  can_mapping:\n"                                                               // 4
+    "    complete_on_id: 0x182\n"                                                    // 5
+    "    fields:\n"                                                                  // 6
+    "      - {id: 0x180, field: counter, byte: 0, type: u32}\n"                      // 7
+    "      - {id: 0x181, field: gyro_x, byte: 0, type: i16, scale: 0.001}\n"         // 8
+    "      - {id: 0x181, field: gyro_y, byte: 2, type: i16, scale: 0.001}\n"         // 9
+    "      - {id: 0x181, field: gyro_z, byte: 4, type: i16, scale: 0.001}\n"         // 10
+    "      - {id: 0x182, field: accel_x, byte: 0, type: i16, byte_order: motorola,"  // 11
+    " scale: 0.01, offset: -0.5}\n"
+    "      - {id: 0x182, field: accel_y, byte: 2, type: i16, scale: 0.01}\n"   // 12
+    "      - {id: 0x182, field: accel_z, byte: 4, type: i16, scale: 0.01}\n";  // 13
+
+/// kCanImu with line `line` (1-based) replaced by `text`.
+std::string with_line(int line, const std::string& text) {
+  std::string out;
+  std::size_t start = 0;
+  for (int i = 1; start < kCanImu.size(); ++i) {
+    const std::size_t end = kCanImu.find('\n', start);
+    out += (i == line ? text : kCanImu.substr(start, end - start)) + "\n";
+    start = end + 1;
+  }
+  return out;
+}
+
+TEST(ConfigCanImu, AMappingLoadsIntoTheDecodersStruct) {
+  const auto r = load(kCanImu);
+  ASSERT_TRUE(r.ok()) << r.error_text();
+  const drivers::can::CanImuMapping& m = r.config.imu.can_mapping;
+  EXPECT_EQ(r.config.imu.source, "can");
+  EXPECT_EQ(r.config.imu.can_interface, "vcan0");
+  ASSERT_EQ(m.fields.size(), 7u);
+  EXPECT_EQ(m.complete_on_id, 0x182u);
+  EXPECT_FALSE(m.complete_on_extended);
+  EXPECT_EQ(m.fields[0].field, drivers::can::ImuField::kCounter);
+  EXPECT_EQ(m.fields[0].type, drivers::can::FieldType::kU32);
+  EXPECT_DOUBLE_EQ(m.fields[0].scale, 1.0);  // defaults: scale 1, offset 0, intel, standard ID
+  EXPECT_FALSE(m.fields[0].big_endian);
+  EXPECT_EQ(m.fields[2].field, drivers::can::ImuField::kGyroY);
+  EXPECT_EQ(m.fields[2].can_id, 0x181u);
+  EXPECT_EQ(m.fields[2].byte_offset, 2);
+  EXPECT_DOUBLE_EQ(m.fields[2].scale, 0.001);
+  EXPECT_TRUE(m.fields[4].big_endian);
+  EXPECT_DOUBLE_EQ(m.fields[4].offset, -0.5);
+  std::string why;
+  EXPECT_TRUE(drivers::can::validate(m, why)) << why;
+}
+
+TEST(ConfigCanImu, ExtendedIdsAndTheCompletingWidthIsInferred) {
+  std::string yaml = "imu:\n  can_mapping:\n    complete_on_id: 0x18FF0001\n    fields:\n";
+  const char* axes[] = {"gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"};
+  for (int i = 0; i < 6; ++i) {
+    yaml += "      - {id: 0x18FF0001, extended: true, field: " + std::string(axes[i]) +
+            ", byte: " + std::to_string(4 * i) + ", type: f32}\n";
+  }
+  const auto r = load(yaml);
+  ASSERT_TRUE(r.ok()) << r.error_text();
+  EXPECT_TRUE(r.config.imu.can_mapping.complete_on_extended);
+  EXPECT_EQ(r.config.imu.can_mapping.fields[5].can_id, 0x18FF0001u);
+  EXPECT_EQ(r.config.imu.source, "serial") << "a mapping alone does not change the source";
+}
+
+TEST(ConfigCanImu, PrintedMappingLoadsBackIdentically) {
+  const auto r = load(kCanImu);
+  ASSERT_TRUE(r.ok()) << r.error_text();
+  const std::string printed = print_config(r.config);
+  EXPECT_NE(printed.find("can_mapping: {complete_on_id: 0x182, complete_on_extended: false, "
+                         "fields: [{id: 0x180, extended: false, field: counter, byte: 0, type: "
+                         "u32, byte_order: intel, scale: 1, offset: 0}, "),
+            std::string::npos)
+      << printed;
+  const auto again = load(printed);
+  ASSERT_TRUE(again.ok()) << again.error_text() << printed;
+  EXPECT_EQ(print_config(again.config), printed);
+  EXPECT_NE(print_config(default_config()).find("can_mapping: {}  #"), std::string::npos);
+}
+
+TEST(ConfigCanImu, EachMistakeIsNamedWithItsLineAndKey) {
+  // A bad value in a field entry: its own key, the entry's line.
+  expect_single_error(load(with_line(9,
+                                     "      - {id: 0x181, field: gyro_y, byte: 2, type: "
+                                     "i17, scale: 0.001}")),
+                      "imu.can_mapping.fields[2].type", 9, "'i17' is not one of: u8,i8,");
+  expect_single_error(load(with_line(8, "      - {id: 0x181, field: gyro_q, byte: 0, type: i16}")),
+                      "imu.can_mapping.fields[1].field", 8, "'gyro_q' is not one of");
+  expect_single_error(load(with_line(8, "      - {id: 0x981, field: gyro_x, byte: 0, type: i16}")),
+                      "imu.can_mapping.fields[1].id", 8, "out of range for an 11-bit ID");
+  expect_single_error(load(with_line(8, "      - {id: 0x181, field: gyro_x, byte: 64, type: i16}")),
+                      "imu.can_mapping.fields[1].byte", 8, "expected a byte offset 0..63");
+  expect_single_error(
+      load(with_line(8, "      - {id: 0x181, field: gyro_x, byte: 0, type: i16, sclae: 2}")),
+      "imu.can_mapping.fields[1].sclae", 8, "unknown key");
+  expect_single_error(load(with_line(8, "      - {id: 0x181, field: gyro_x, type: i16}")),
+                      "imu.can_mapping.fields[1].byte", 8, "missing");
+  expect_single_error(
+      load(with_line(11,
+                     "      - {id: 0x182, field: accel_x, byte: 0, type: i16, byte_order: "
+                     "big}")),
+      "imu.can_mapping.fields[4].byte_order", 11, "not one of: intel,motorola");
+  // What validate() finds: the entry it names, or the mapping's own keys.
+  expect_single_error(load(with_line(9, "      - {id: 0x181, field: gyro_x, byte: 2, type: i16}")),
+                      "imu.can_mapping.fields[2]", 9, "gyro_x mapped twice");
+  expect_single_error(load(with_line(8, "      - {id: 0x181, field: gyro_x, byte: 62, type: i32}")),
+                      "imu.can_mapping.fields[1]", 8, "exceed 64");
+  expect_single_error(load(with_line(5, "    complete_on_id: 0x183")),
+                      "imu.can_mapping.complete_on_id", 5, "not one of the mapped IDs");
+  expect_single_error(load(with_line(13, "")), "imu.can_mapping.fields", 7, "missing: accel_z");
+  // imu.source can needs a mapping.
+  expect_single_error(load("imu:\n  source: can\n"), "imu.can_mapping", 2,
+                      "imu.source is can but no imu.can_mapping");
+  expect_single_error(load("imu:\n  can_mapping: [1, 2]\n"), "imu.can_mapping", 2,
+                      "expected a mapping");
+  // A counter ClockSync would unwrap at the wrong place.
+  const std::string u16_counter =
+      with_line(7, "      - {id: 0x180, field: counter, byte: 0, type: u16, scale: 100}");
+  expect_single_error(load(u16_counter), "imu.can_mapping.fields[0]", 7,
+                      "needs a microsecond counter that wraps at 2^32");
+  EXPECT_TRUE(load(u16_counter + "  clock_kind: none\n").ok());
 }
 
 }  // namespace

@@ -231,5 +231,32 @@ TEST(CanImuMapping, ValidateSaysWhatIsWrong) {
   EXPECT_EQ(d.decode(f, r), CanImuStatus::kIgnored);
 }
 
+TEST(CanImuMapping, NamesRoundTripAndValidateSaysWhichEntry) {
+  for (int i = 0; i <= static_cast<int>(ImuField::kCounter); ++i) {
+    const auto f = static_cast<ImuField>(i);
+    EXPECT_EQ(imu_field_from_string(to_string(f)), f);
+  }
+  for (int i = 0; i <= static_cast<int>(FieldType::kF32); ++i) {
+    const auto t = static_cast<FieldType>(i);
+    EXPECT_EQ(field_type_from_string(to_string(t)), t);
+  }
+  EXPECT_EQ(imu_field_from_string("gyro_w"), std::nullopt);
+  EXPECT_EQ(field_type_from_string("i64"), std::nullopt);
+  EXPECT_EQ(field_size(FieldType::kF32), 4u);
+
+  std::string error;
+  std::size_t bad = 0;
+  CanImuMapping m = example_mapping();
+  EXPECT_TRUE(validate(m, error, bad)) << error;
+  m.fields[2].field = ImuField::kGyroX;
+  EXPECT_FALSE(validate(m, error, bad));
+  EXPECT_EQ(bad, 2u);
+  EXPECT_NE(error.find("gyro_x mapped twice"), std::string::npos) << error;
+  m = example_mapping();
+  m.complete_on_id = 0x999;
+  EXPECT_FALSE(validate(m, error, bad));
+  EXPECT_EQ(bad, std::string::npos) << "a problem of the mapping as a whole";
+}
+
 }  // namespace
 }  // namespace posed::drivers::can
