@@ -119,7 +119,14 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     // Thermal-only tracking has no visible stamp to compensate to.
     const Eigen::Matrix3d R =
         mode == FrontendMode::kFused ? input.R_camtv_camtt : Eigen::Matrix3d::Identity();
-    const bool aligned = aligner_->align(input.thermal, R, thermal_aligned_, out.thermal_alignment);
+    // Depth-aware registration (kLidarDepth) only for the fusion, which needs the thermal image
+    // on the visible one pixel for pixel. Tracked alone, the thermal image registered at infinity
+    // is the thermal camera's own view through a pure rotation; a warp by a per-frame lidar depth
+    // grid would only add distortion that changes from frame to frame.
+    const std::span<const Eigen::Vector3f> points =
+        mode == FrontendMode::kFused ? input.p_cam_m : std::span<const Eigen::Vector3f>();
+    const bool aligned =
+        aligner_->align(input.thermal, R, thermal_aligned_, out.thermal_alignment, points);
     if (aligned) {
       if (config_.thermal_enhance.enabled) {
         thermal_enhancer_.enhance_to_grey(thermal_aligned_, false, thermal_grey_);

@@ -249,11 +249,16 @@ const Field kSchema[] = {
     F("frontend.clahe_clip_limit", frontend.clahe_clip_limit, "2", "", 0.5, 40, "",
       "CLAHE histogram clip, in multiples of the uniform bin"),
     F("frontend.thermal_registration", frontend.thermal_registration, "infinity", "", 0, 0,
-      "infinity|plane|fov_crop",
+      "infinity|plane|fov_crop|lidar_depth",
       "thermal onto the visible pixel grid: homography at infinity, a plane at "
-      "thermal_plane_depth_m, or seed 000's centred FOV crop"),
+      "thermal_plane_depth_m, seed 000's centred FOV crop, or per pixel at the lidar's depth "
+      "(a coarse grid; infinity where it has no points)"),
     F("frontend.thermal_plane_depth_m", frontend.thermal_plane_depth_m, "10", "m", 0.5, 1000, "",
       "depth of the registration plane for thermal_registration: plane"),
+    F("frontend.thermal_depth_grid_cols", frontend.thermal_depth_grid_cols, "40", "", 1, 640, "",
+      "thermal_registration: lidar_depth: cells of the depth grid across the image"),
+    F("frontend.thermal_depth_grid_rows", frontend.thermal_depth_grid_rows, "30", "", 1, 480, "",
+      "thermal_registration: lidar_depth: cells of the depth grid down the image"),
     F("frontend.rotation_compensation", frontend.rotation_compensation, "true", "", 0, 0, "",
       "warp the thermal frame by the gyro's rotation between its stamp and its visible partner's"),
     F("frontend.wavelet", frontend.wavelet, "haar", "", 0, 0, "haar|legall53|cdf97",

@@ -59,10 +59,14 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
     f.thermal_align.mode = vision::AlignMode::kPlane;
   } else if (s.thermal_registration == "fov_crop") {
     f.thermal_align.mode = vision::AlignMode::kFovCrop;
+  } else if (s.thermal_registration == "lidar_depth") {
+    f.thermal_align.mode = vision::AlignMode::kLidarDepth;
   } else {
     f.thermal_align.mode = vision::AlignMode::kInfiniteHomography;
   }
   f.thermal_align.plane_depth_m = s.thermal_plane_depth_m;
+  f.thermal_align.depth_grid_cols = s.thermal_depth_grid_cols;
+  f.thermal_align.depth_grid_rows = s.thermal_depth_grid_rows;
   f.thermal_align.rotation_compensation = s.rotation_compensation;
   if (s.wavelet == "legall53") {
     f.fusion.wavelet = vision::Wavelet::kLeGall53;
