@@ -176,11 +176,22 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     // bilinear upsampling by 1/s scales white noise by about s (0.67 measured for s = 0.71).
     const double thermal_scale =
         aligner_->source_roi().width / static_cast<double>(config_.visible_camera.width);
-    const double visible_noise = out.quality.visible.valid ? out.quality.visible.noise_sigma : 0;
-    const double thermal_noise =
+    double visible_noise = out.quality.visible.valid ? out.quality.visible.noise_sigma : 0;
+    double thermal_noise =
         out.quality.thermal.valid ? out.quality.thermal.noise_sigma * thermal_scale : 0;
     begin(FrontendStep::kFusion);
-    fusion_.fuse(visible_grey_, thermal_grey_, fused_grey_, visible_noise, thermal_noise);
+    const cv::Mat* visible_in = &visible_grey_;
+    const cv::Mat* thermal_in = &thermal_grey_;
+    if (config_.fusion.denoise) {
+      const FusionConfig& f = config_.fusion;
+      visible_noise = denoise_gaussian(visible_grey_, visible_noise, f.denoise_target_sigma,
+                                       f.denoise_max_sigma_px, visible_denoised_);
+      thermal_noise = denoise_gaussian(thermal_grey_, thermal_noise, f.denoise_target_sigma,
+                                       f.denoise_max_sigma_px, thermal_denoised_);
+      visible_in = &visible_denoised_;
+      thermal_in = &thermal_denoised_;
+    }
+    fusion_.fuse(*visible_in, *thermal_in, fused_grey_, visible_noise, thermal_noise);
     end(FrontendStep::kFusion);
     if (config_.assess_quality) {
       begin(FrontendStep::kQuality);

@@ -263,6 +263,14 @@ const Field kSchema[] = {
       "warp the thermal frame by the gyro's rotation between its stamp and its visible partner's"),
     F("frontend.wavelet", frontend.wavelet, "haar", "", 0, 0, "haar|legall53|cdf97",
       "wavelet of the 2-level DWT fusion"),
+    F("frontend.fusion_noise_weighted", frontend.fusion_noise_weighted, "true", "", 0, 0, "",
+      "detail coefficients chosen by significance over each stream's noise (false: the larger "
+      "magnitude, seed 000's eq. 8 as published)"),
+    F("frontend.fusion_denoise", frontend.fusion_denoise, "true", "", 0, 0, "",
+      "smooth each stream noisier than fusion_denoise_target_sigma (its estimated noise) by a "
+      "Gaussian before the fusion"),
+    F("frontend.fusion_denoise_target_sigma", frontend.fusion_denoise_target_sigma, "2", "grey",
+      0.1, 50, "", "noise level the pre-smoothing aims for"),
     F("frontend.max_features", frontend.max_features, "300", "", 20, 2000, "",
       "point features kept per frame (seed 001: 200-400)"),
     F("frontend.min_feature_distance_px", frontend.min_feature_distance_px, "20", "px", 2, 200, "",

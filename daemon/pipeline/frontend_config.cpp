@@ -75,6 +75,9 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   } else {
     f.fusion.wavelet = vision::Wavelet::kHaar;
   }
+  f.fusion.noise_weighted = s.fusion_noise_weighted;
+  f.fusion.denoise = s.fusion_denoise;
+  f.fusion.denoise_target_sigma = s.fusion_denoise_target_sigma;
   f.tracker.max_features = s.max_features;
   f.tracker.min_distance_px = s.min_feature_distance_px;
   f.tracker.ransac_threshold_px = s.ransac_threshold_px;
