@@ -1,7 +1,9 @@
 #include "core/vision/dwt_fusion.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace posed::vision {
 
@@ -52,6 +54,23 @@ void fuse_high_band_noise_aware(const cv::Mat& visible, const cv::Mat& thermal,
       o[c] = take_thermal ? t[c] : v[c];
     }
   }
+}
+
+double denoise_gaussian(const cv::Mat& grey, double noise_sigma, double target_sigma,
+                        double max_sigma_px, cv::Mat& out) {
+  CV_Assert(grey.type() == CV_8UC1);
+  if (!(noise_sigma > target_sigma) || !(target_sigma > 0) || !(max_sigma_px > 0)) {
+    out = grey;
+    return noise_sigma;
+  }
+  // Continuous approximation for the width, the discrete kernel for the residual.
+  constexpr double kTwoSqrtPi = 3.5449077018110318;
+  const double sigma_px = std::min(max_sigma_px, noise_sigma / (kTwoSqrtPi * target_sigma));
+  const int ksize = 2 * static_cast<int>(std::ceil(3.0 * sigma_px)) + 1;
+  const cv::Mat taps = cv::getGaussianKernel(ksize, sigma_px, CV_64F);
+  const double gain = taps.dot(taps);  // 2-D: (sum k_i^2)^2 in variance, its root in sigma
+  cv::GaussianBlur(grey, out, cv::Size(ksize, ksize), sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  return noise_sigma * gain;
 }
 
 DwtFusion::DwtFusion(const FusionConfig& config)

@@ -119,7 +119,14 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     // Thermal-only tracking has no visible stamp to compensate to.
     const Eigen::Matrix3d R =
         mode == FrontendMode::kFused ? input.R_camtv_camtt : Eigen::Matrix3d::Identity();
-    const bool aligned = aligner_->align(input.thermal, R, thermal_aligned_, out.thermal_alignment);
+    // Depth-aware registration (kLidarDepth) only for the fusion, which needs the thermal image
+    // on the visible one pixel for pixel. Tracked alone, the thermal image registered at infinity
+    // is the thermal camera's own view through a pure rotation; a warp by a per-frame lidar depth
+    // grid would only add distortion that changes from frame to frame.
+    const std::span<const Eigen::Vector3f> points =
+        mode == FrontendMode::kFused ? input.p_cam_m : std::span<const Eigen::Vector3f>();
+    const bool aligned =
+        aligner_->align(input.thermal, R, thermal_aligned_, out.thermal_alignment, points);
     if (aligned) {
       if (config_.thermal_enhance.enabled) {
         thermal_enhancer_.enhance_to_grey(thermal_aligned_, false, thermal_grey_);
@@ -169,11 +176,22 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     // bilinear upsampling by 1/s scales white noise by about s (0.67 measured for s = 0.71).
     const double thermal_scale =
         aligner_->source_roi().width / static_cast<double>(config_.visible_camera.width);
-    const double visible_noise = out.quality.visible.valid ? out.quality.visible.noise_sigma : 0;
-    const double thermal_noise =
+    double visible_noise = out.quality.visible.valid ? out.quality.visible.noise_sigma : 0;
+    double thermal_noise =
         out.quality.thermal.valid ? out.quality.thermal.noise_sigma * thermal_scale : 0;
     begin(FrontendStep::kFusion);
-    fusion_.fuse(visible_grey_, thermal_grey_, fused_grey_, visible_noise, thermal_noise);
+    const cv::Mat* visible_in = &visible_grey_;
+    const cv::Mat* thermal_in = &thermal_grey_;
+    if (config_.fusion.denoise) {
+      const FusionConfig& f = config_.fusion;
+      visible_noise = denoise_gaussian(visible_grey_, visible_noise, f.denoise_target_sigma,
+                                       f.denoise_max_sigma_px, visible_denoised_);
+      thermal_noise = denoise_gaussian(thermal_grey_, thermal_noise, f.denoise_target_sigma,
+                                       f.denoise_max_sigma_px, thermal_denoised_);
+      visible_in = &visible_denoised_;
+      thermal_in = &thermal_denoised_;
+    }
+    fusion_.fuse(*visible_in, *thermal_in, fused_grey_, visible_noise, thermal_noise);
     end(FrontendStep::kFusion);
     if (config_.assess_quality) {
       begin(FrontendStep::kQuality);

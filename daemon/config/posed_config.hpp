@@ -124,10 +124,15 @@ struct FrontendSection {
   bool enhance_visible = true;
   double gamma_target_mean = 0.5;                 ///< [0..1]
   double clahe_clip_limit = 2.0;                  ///< [x uniform bin]
-  std::string thermal_registration = "infinity";  ///< infinity | plane | fov_crop
+  std::string thermal_registration = "infinity";  ///< infinity | plane | fov_crop | lidar_depth
   double thermal_plane_depth_m = 10;              ///< [m]
+  int thermal_depth_grid_cols = 40;  ///< lidar_depth registration grid [cells]
+  int thermal_depth_grid_rows = 30;  ///< [cells]
   bool rotation_compensation = true;
   std::string wavelet = "haar";  ///< haar | legall53 | cdf97
+  bool fusion_noise_weighted = true;  ///< false: seed 000's eq. (8) as published
+  bool fusion_denoise = true;  ///< noise-adaptive pre-smoothing of the fusion inputs
+  double fusion_denoise_target_sigma = 2.0;  ///< [grey]
   int max_features = 300;
   double min_feature_distance_px = 20;  ///< [px]
   double ransac_threshold_px = 1;       ///< [px]

@@ -59,10 +59,14 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
     f.thermal_align.mode = vision::AlignMode::kPlane;
   } else if (s.thermal_registration == "fov_crop") {
     f.thermal_align.mode = vision::AlignMode::kFovCrop;
+  } else if (s.thermal_registration == "lidar_depth") {
+    f.thermal_align.mode = vision::AlignMode::kLidarDepth;
   } else {
     f.thermal_align.mode = vision::AlignMode::kInfiniteHomography;
   }
   f.thermal_align.plane_depth_m = s.thermal_plane_depth_m;
+  f.thermal_align.depth_grid_cols = s.thermal_depth_grid_cols;
+  f.thermal_align.depth_grid_rows = s.thermal_depth_grid_rows;
   f.thermal_align.rotation_compensation = s.rotation_compensation;
   if (s.wavelet == "legall53") {
     f.fusion.wavelet = vision::Wavelet::kLeGall53;
@@ -71,6 +75,9 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   } else {
     f.fusion.wavelet = vision::Wavelet::kHaar;
   }
+  f.fusion.noise_weighted = s.fusion_noise_weighted;
+  f.fusion.denoise = s.fusion_denoise;
+  f.fusion.denoise_target_sigma = s.fusion_denoise_target_sigma;
   f.tracker.max_features = s.max_features;
   f.tracker.min_distance_px = s.min_feature_distance_px;
   f.tracker.ransac_threshold_px = s.ransac_threshold_px;

@@ -421,6 +421,32 @@ int bench_frontend() {
     report("frontend", "fusion_published_confidence_mean", r.confidence, "ratio");
   }
 
+  // Without the noise-adaptive pre-smoothing of the fusion inputs.
+  {
+    vision::FrontendConfig c = config;
+    c.fusion.denoise = false;
+    RunFigures r;
+    run(c, frames, false, r);
+    report("frontend", "fusion_no_denoise_median", quantile_ms(r.timer.step(2), 0.5), "ms");
+    report("frontend", "fusion_no_denoise_match_success",
+           r.previous > 0 ? r.inliers / r.previous : 0, "ratio");
+    report("frontend", "fusion_no_denoise_confidence_mean", r.confidence, "ratio");
+  }
+
+  // Option: the thermal image registered at the lidar's depth instead of at infinity.
+  {
+    vision::FrontendConfig c = config;
+    c.thermal_align.mode = vision::AlignMode::kLidarDepth;
+    RunFigures r;
+    run(c, frames, false, r);
+    report("frontend", "lidar_depth_thermal_median", quantile_ms(r.timer.step(1), 0.5), "ms");
+    report("frontend", "lidar_depth_total_median", quantile_ms(r.timer.totals(), 0.5), "ms");
+    report("frontend", "lidar_depth_total_p99", quantile_ms(r.timer.totals(), 0.99), "ms");
+    report("frontend", "lidar_depth_match_success", r.previous > 0 ? r.inliers / r.previous : 0,
+           "ratio");
+    report("frontend", "lidar_depth_depth_associated_mean", r.depth, "features");
+  }
+
   // Option: LSD line features.
   vision::FrontendConfig with_lines = config;
   with_lines.lines = true;

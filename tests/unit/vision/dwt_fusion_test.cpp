@@ -6,9 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/vision/image_quality.hpp"
 #include "tests/unit/vision/synthetic_scene.hpp"
 
 namespace posed::vision {
@@ -144,6 +147,64 @@ TEST(DwtFusion, KeepsTheFineDetailOfBothImagesAndAveragesTheCoarse) {
   EXPECT_NEAR(disc_step, 70.0, 5.0);
   // A flat patch away from everything is the low bands' average: (60 + 100) / 2.
   EXPECT_NEAR(cv::mean(fused(cv::Rect(56, 2, 20, 4)))[0], 80.0, 2.0);
+}
+
+/// A vertical step from 60 to 160 grey at column 320 (640x480).
+cv::Mat step_image() {
+  cv::Mat image(480, 640, CV_8UC1, cv::Scalar(60));
+  image(cv::Rect(320, 0, 320, 480)).setTo(160);
+  return image;
+}
+
+TEST(DenoiseGaussian, BringsTheNoiseDownToTheTargetAndKeepsTheEdge) {
+  const double sigma = 15.0, target = 2.0;
+  const cv::Mat clean = step_image();
+  const cv::Mat noisy = scene::add_noise(clean, sigma, 7);
+  cv::Mat denoised, denoised_clean;
+  const double residual = denoise_gaussian(noisy, sigma, target, 3.0, denoised);
+  EXPECT_NEAR(residual, target, 0.1);  // sigma 15 / (2 sqrt(pi) 2) = 2.1 px is within the cap
+  // The noise actually left: the smoothed noisy image against the smoothed clean one, in flat
+  // regions (the filter is linear; rounding adds 0.29 grey).
+  denoise_gaussian(clean, sigma, target, 3.0, denoised_clean);
+  cv::Mat diff;
+  cv::subtract(denoised, denoised_clean, diff, cv::noArray(), CV_32F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(diff(cv::Rect(20, 20, 280, 440)), mean, stddev);
+  EXPECT_NEAR(stddev[0], residual, 0.25 * residual);
+  // The quality module's noise metric sees it too.
+  QualityAssessor quality{QualityConfig{}};
+  const double before = quality.assess(noisy).noise_sigma;
+  const double after = quality.assess(denoised).noise_sigma;
+  EXPECT_GT(before, 12.0);
+  EXPECT_LT(after, 0.35 * before);
+  // The edge stays where it was, and steep: 4 px either side (~2 sigma of the kernel) the
+  // row-averaged profile is within 5 % of the contrast of each side's level.
+  cv::Mat profile;
+  cv::reduce(denoised, profile, 0, cv::REDUCE_AVG, CV_64F);
+  EXPECT_LT(profile.at<double>(0, 315), 65.0);
+  EXPECT_GT(profile.at<double>(0, 324), 155.0);
+  EXPECT_NEAR(profile.at<double>(0, 319) + profile.at<double>(0, 320), 220.0, 6.0);
+}
+
+TEST(DenoiseGaussian, QuietOrUnknownImagesPassUntouched) {
+  const cv::Mat image = scene::add_noise(step_image(), 1.5, 3);
+  cv::Mat out;
+  EXPECT_EQ(denoise_gaussian(image, 1.5, 2.0, 3.0, out), 1.5);
+  EXPECT_EQ(out.data, image.data);  // a view, no copy
+  EXPECT_EQ(denoise_gaussian(image, 0.0, 2.0, 3.0, out), 0.0);
+  EXPECT_EQ(out.data, image.data);
+}
+
+TEST(DenoiseGaussian, TheKernelIsCappedAndTheResidualSaysSo) {
+  // Sigma 30 would need a 4.2 px kernel to reach 2 grey; capped at 1 px it leaves 30 x 0.28.
+  const cv::Mat clean(480, 640, CV_8UC1, cv::Scalar(128));
+  const cv::Mat noisy = scene::add_noise(clean, 30.0, 5);
+  cv::Mat out;
+  const double residual = denoise_gaussian(noisy, 30.0, 2.0, 1.0, out);
+  EXPECT_NEAR(residual, 30.0 / (2.0 * std::sqrt(std::numbers::pi)), 0.5);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(out, mean, stddev);
+  EXPECT_NEAR(stddev[0], residual, 0.2 * residual);
 }
 
 }  // namespace

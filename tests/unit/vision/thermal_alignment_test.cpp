@@ -189,6 +189,121 @@ TEST(ThermalAligner, FovCropModeSamplesTheEquationSixRegion) {
   EXPECT_NEAR(thermal_px.x(), edge.x(), 1e-6);
 }
 
+/// Lidar-like points on the rectangle x in [x0, x1], y in [y0, y1] of the plane z = depth_m
+/// (visible camera frame): rings every `ring_rad` of elevation, 0.2 deg apart along a ring.
+std::vector<Eigen::Vector3f> plane_points(double depth_m, double x0, double x1, double y0,
+                                          double y1, double ring_rad) {
+  std::vector<Eigen::Vector3f> points;
+  for (double elevation = -0.6; elevation <= 0.6; elevation += ring_rad) {
+    for (double azimuth = -0.8; azimuth <= 0.8; azimuth += 0.0035) {
+      const Eigen::Vector3d d(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
+                              std::cos(azimuth) * std::cos(elevation));
+      const Eigen::Vector3d p = d * (depth_m / d.z());
+      if (p.x() >= x0 && p.x() <= x1 && p.y() >= y0 && p.y() <= y1) {
+        points.push_back(p.cast<float>());
+      }
+    }
+  }
+  return points;
+}
+
+/// A warm spot (Gaussian, sigma 2 px) at a thermal pixel, on a black 640x512 frame.
+cv::Mat warm_spot(const Eigen::Vector2d& thermal_px) {
+  cv::Mat thermal(512, 640, CV_8UC1);
+  for (int r = 0; r < 512; ++r)
+    for (int c = 0; c < 640; ++c) {
+      const double d2 = std::pow(c - thermal_px.x(), 2) + std::pow(r - thermal_px.y(), 2);
+      thermal.at<std::uint8_t>(r, c) = cv::saturate_cast<std::uint8_t>(250 * std::exp(-d2 / 8));
+    }
+  return thermal;
+}
+
+TEST(ThermalAligner, LidarDepthPutsANearThermalSpotOnItsVisiblePixel) {
+  // A board 3 m ahead in front of a wall 40 m away, both sampled by lidar rings 2 deg apart
+  // (further apart than the depth grid's rows: some cells are filled from their neighbours). A
+  // warm spot on the board must land on the board point's visible pixel; at infinity it is
+  // displaced by the parallax f_v b / z = 617.97 * 0.17 / 3 = 35.0 px.
+  const double z = 3.0;
+  const Eigen::Vector3d p_cam(-0.4, 0.1, z);
+  std::vector<Eigen::Vector3f> points = plane_points(z, -1.2, 0.4, -0.6, 0.6, 0.035);
+  const std::vector<Eigen::Vector3f> wall = plane_points(40.0, -100, 100, -100, 100, 0.035);
+  const std::size_t board_points = points.size();
+  for (const Eigen::Vector3f& p : wall) {
+    // The wall behind the board is hidden from the lidar (which sits at the visible camera).
+    if (!(p.x() / p.z() * z >= -1.2 && p.x() / p.z() * z <= 0.4 && p.y() / p.z() * z >= -0.6 &&
+          p.y() / p.z() * z <= 0.6)) {
+      points.push_back(p);
+    }
+  }
+  ASSERT_GT(board_points, 500u);
+  Eigen::Vector2d visible_px, thermal_px;
+  ASSERT_TRUE(m2dgr_visible().project(p_cam, visible_px));
+  ASSERT_TRUE(m2dgr_thermal().project(m2dgr_T_cam_thermal().inverse() * p_cam, thermal_px));
+  const cv::Mat thermal = warm_spot(thermal_px);
+  const auto centroid = [](const cv::Mat& image) {
+    const cv::Moments m = cv::moments(image);
+    return Eigen::Vector2d(m.m10 / m.m00, m.m01 / m.m00);
+  };
+
+  ThermalAligner depth_aware = make_aligner(AlignMode::kLidarDepth);
+  cv::Mat aligned;
+  AlignStats stats;
+  ASSERT_TRUE(depth_aware.align(thermal, Eigen::Matrix3d::Identity(), aligned, stats, points));
+  EXPECT_GT(stats.depth_cells, 0);
+  EXPECT_GT(stats.depth_filled_cells, 0);  // the rows between the rings
+  EXPECT_LT((centroid(aligned) - visible_px).norm(), 1.0);
+  Eigen::Vector2d mapped_px;  // the same through the per-pixel query
+  ASSERT_TRUE(depth_aware.thermal_pixel(visible_px, Eigen::Matrix3d::Identity(), mapped_px));
+  EXPECT_LT((mapped_px - thermal_px).norm(), 0.5);
+  ASSERT_FALSE(depth_aware.inverse_depth().empty());
+  EXPECT_NEAR(depth_aware.inverse_depth().at<float>(static_cast<int>(std::lround(visible_px.y())),
+                                                    static_cast<int>(std::lround(visible_px.x()))),
+              1.0 / z, 1e-3);
+
+  ThermalAligner infinite = make_aligner(AlignMode::kInfiniteHomography);
+  ASSERT_TRUE(infinite.align(thermal, Eigen::Matrix3d::Identity(), aligned, stats));
+  const double parallax_px = (centroid(aligned) - visible_px).norm();
+  EXPECT_NEAR(parallax_px, 617.971 * 0.17 / z, 1.5);
+}
+
+TEST(ThermalAligner, LidarDepthWithoutPointsIsTheHomographyAtInfinity) {
+  const cv::Mat thermal = scene::render_wall(m2dgr_thermal(), scene::pixel_rays(m2dgr_thermal()),
+                                             m2dgr_T_cam_thermal(), 6.0, 200, 20, 3);
+  cv::Mat depth_aligned, infinite_aligned;
+  AlignStats stats;
+  ThermalAligner depth_aware = make_aligner(AlignMode::kLidarDepth);
+  ASSERT_TRUE(depth_aware.align(thermal, Eigen::Matrix3d::Identity(), depth_aligned, stats));
+  EXPECT_EQ(stats.depth_cells, 0);
+  EXPECT_TRUE(depth_aware.inverse_depth().empty());
+  ThermalAligner infinite = make_aligner(AlignMode::kInfiniteHomography);
+  ASSERT_TRUE(infinite.align(thermal, Eigen::Matrix3d::Identity(), infinite_aligned, stats));
+  EXPECT_EQ(cv::norm(depth_aligned, infinite_aligned, cv::NORM_INF), 0);
+  // Points behind the camera or nearer than depth_min_m do not count either.
+  const std::vector<Eigen::Vector3f> useless = {{0, 0, -5}, {0.1f, 0, 0.2f}};
+  ASSERT_TRUE(
+      depth_aware.align(thermal, Eigen::Matrix3d::Identity(), depth_aligned, stats, useless));
+  EXPECT_EQ(stats.depth_cells, 0);
+}
+
+TEST(ThermalAligner, LidarDepthRegistersAWholeRenderedSceneLikeThePlane) {
+  // The rendered wall 6 m ahead, its depth known only from lidar rings 1.3 deg apart: as good as
+  // registering the known plane.
+  const double depth = 6.0;
+  const cv::Mat visible = scene::render_wall(m2dgr_visible(), scene::pixel_rays(m2dgr_visible()),
+                                             Eigen::Isometry3d::Identity(), depth, 200, 20, 1);
+  const cv::Mat thermal = scene::render_wall(m2dgr_thermal(), scene::pixel_rays(m2dgr_thermal()),
+                                             m2dgr_T_cam_thermal(), depth, 200, 20, 1);
+  const std::vector<Eigen::Vector3f> points = plane_points(depth, -100, 100, -100, 100, 0.0227);
+  cv::Mat aligned;
+  AlignStats stats;
+  ThermalAligner plane = make_aligner(AlignMode::kPlane, depth);
+  ASSERT_TRUE(plane.align(thermal, Eigen::Matrix3d::Identity(), aligned, stats));
+  const double plane_difference = mean_difference(aligned, visible);
+  ThermalAligner depth_aware = make_aligner(AlignMode::kLidarDepth);
+  ASSERT_TRUE(depth_aware.align(thermal, Eigen::Matrix3d::Identity(), aligned, stats, points));
+  EXPECT_LT(mean_difference(aligned, visible), plane_difference + 0.1);
+}
+
 TEST(ThermalAligner, RejectsFramesOfTheWrongSizeOrType) {
   ThermalAligner aligner = make_aligner(AlignMode::kInfiniteHomography);
   cv::Mat aligned;
