@@ -226,12 +226,16 @@ bool load_calibration(const std::string& path, Calibration& out, std::string& er
   }
   std::stringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  return parse_calibration_text(buffer.str(), path, out, error);
+}
+
+bool parse_calibration_text(std::string_view text, std::string_view name, Calibration& out,
+                            std::string& error) {
   const auto first = text.find_first_not_of(" \t\r\n");
-  if (first != std::string::npos && text[first] == '<') {
-    return parse_calibration_xml(text, path, out, error);
+  if (first != std::string_view::npos && text[first] == '<') {
+    return parse_calibration_xml(text, name, out, error);
   }
-  return parse_calibration_yaml(text, path, out, error);
+  return parse_calibration_yaml(text, name, out, error);
 }
 
 }  // namespace posed::drivers::velodyne

@@ -24,5 +24,8 @@ bool parse_calibration_xml(std::string_view text, std::string_view name, Calibra
                            std::string& error);
 bool parse_calibration_yaml(std::string_view text, std::string_view name, Calibration& out,
                             std::string& error);
+/// Either format, chosen by content as load_calibration does.
+bool parse_calibration_text(std::string_view text, std::string_view name, Calibration& out,
+                            std::string& error);
 
 }  // namespace posed::drivers::velodyne
