@@ -10,6 +10,7 @@
 
 #include "daemon/build_info.hpp"
 #include "daemon/config/config_loader.hpp"
+#include "daemon/pipeline/replay_sources.hpp"
 #include "daemon/run_daemon.hpp"
 #include "drivers/common/log.hpp"
 
@@ -24,8 +25,9 @@ int main(int argc, char** argv) noexcept try {
   posed::RunOptions options;
   bool print_config = false;
   bool version = false;
-  app.add_option("-c,--config", options.config_path, "configuration file (YAML)")
-      ->capture_default_str();
+  auto* config_option =
+      app.add_option("-c,--config", options.config_path, "configuration file (YAML)")
+          ->capture_default_str();
   app.add_flag("--print-config", print_config,
                "print the effective configuration with units, ranges and descriptions, then exit");
   app.add_option("--duration", options.duration_s,
@@ -55,6 +57,12 @@ int main(int argc, char** argv) noexcept try {
   app.add_option("--start", options.replay.start_s, "skip this much of the recording [s]")
       ->check(CLI::NonNegativeNumber)
       ->needs(replay);
+  app.add_flag("--recorded-config", options.replay.recorded_config,
+               "with --replay: run with the configuration the recording was made with (posed "
+               "--record and posectl record store it, with the lidar calibration file's text), as "
+               "the robot ran; its dds section is replaced by --config's (this machine's "
+               "network), or the defaults without --config")
+      ->needs(replay);
   app.add_option("--wait-subscribers", options.wait_subscribers_s,
                  "before publishing, wait up to this long for a reader of rt/posed/odom or "
                  "rt/posed/pose to match [s]; default 1 with --replay, 0 live")
@@ -69,7 +77,27 @@ int main(int argc, char** argv) noexcept try {
                 posed::version_string().data());
     return 0;
   }
-  const auto loaded = posed::config::load_config_file(options.config_path);
+  auto loaded = posed::config::load_config_file(options.config_path);
+  if (options.replay.recorded_config) {
+    // The recording's configuration, with this machine's DDS settings: --config's, or the
+    // defaults when none was given (the robot's network settings rarely fit a laptop).
+    const bool local_config_given = config_option->count() > 0;
+    if (!local_config_given) loaded.errors.clear();
+    std::string yaml, error;
+    if (!posed::pipeline::read_recorded_config(options.replay.path, yaml, error)) {
+      std::fprintf(stderr, "posed: %s\n", error.c_str());
+      return 2;
+    }
+    auto recorded =
+        posed::config::load_config_text(yaml, options.replay.path + " (recorded configuration)");
+    if (loaded.ok() && recorded.ok()) {
+      recorded.config.dds =
+          local_config_given ? loaded.config.dds : posed::config::default_config().dds;
+    }
+    if (!loaded.ok())
+      recorded.errors.insert(recorded.errors.begin(), loaded.errors.begin(), loaded.errors.end());
+    loaded = std::move(recorded);
+  }
   if (!loaded.ok()) {
     std::fprintf(stderr, "posed: invalid configuration:\n%s", loaded.error_text().c_str());
     return 2;

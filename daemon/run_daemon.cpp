@@ -135,6 +135,11 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     if (replay.have_host_to_wall) to_wall = replay.host_to_wall;
     built = std::move(replay.built);
     replay_streams = replay.streams;
+    if (options.replay.recorded_config) {
+      POSED_LOG_INFO("configuration as recorded in %s%s%s", options.replay.path.c_str(),
+                     built.sources.lidar_calibration_text.empty() ? "" : "; lidar calibration: ",
+                     built.sources.lidar_calibration_name.c_str());
+    }
   } else {
     if (config.visible_camera.enabled && config.visible_camera.source == "v4l2") {
       drivers::camera::LibusbTransport usb;

@@ -38,7 +38,8 @@ void ImuStage::on_can_frame(const drivers::RawChunk& chunk) {
       POSED_LOG_ERROR(
           "imu: CAN frames (wire format linux-can-frame) but no imu.can_mapping in the "
           "configuration says which of them carry the IMU's fields: frames skipped (see "
-          "config/imu-can-example.yaml)");
+          "config/imu-can-example.yaml; a recording made by posed carries the mapping it was "
+          "made with: posed --replay FILE --recorded-config)");
     }
     return;
   }

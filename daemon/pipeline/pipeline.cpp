@@ -130,8 +130,13 @@ bool Pipeline::start(std::string& error) {
     return false;
   }
   drivers::velodyne::Calibration calibration;  // empty: the manual's table for the model seen
-  if (sources_.lidar && !config_.lidar.calibration.empty() &&
-      !drivers::velodyne::load_calibration(config_.lidar.calibration, calibration, error)) {
+  if (sources_.lidar && !sources_.lidar_calibration_text.empty()) {
+    if (!drivers::velodyne::parse_calibration_text(
+            sources_.lidar_calibration_text, sources_.lidar_calibration_name, calibration, error)) {
+      return false;
+    }
+  } else if (sources_.lidar && !config_.lidar.calibration.empty() &&
+             !drivers::velodyne::load_calibration(config_.lidar.calibration, calibration, error)) {
     return false;
   }
   std::size_t stage = 0;

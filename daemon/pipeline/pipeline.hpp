@@ -52,6 +52,12 @@ struct PipelineSources {
   std::unique_ptr<drivers::Source> visible;
   /// PLUG 617 thermal frames (channel 0); optional
   std::unique_ptr<drivers::Source> thermal;
+  /// The Velodyne calibration the lidar stream was recorded with (its file's text, from the
+  /// recording; `posed --replay FILE --recorded-config`), used instead of lidar.calibration so a
+  /// replay decodes the packets as the robot did; empty: lidar.calibration as configured.
+  std::string lidar_calibration_text;
+  /// where that text came from, for messages
+  std::string lidar_calibration_name;
 
   /// The camera Source of a stream (null when absent).
   std::unique_ptr<drivers::Source>& camera(CameraStream s) {

@@ -12,16 +12,53 @@ namespace posed::pipeline {
 
 namespace recording = drivers::recording;
 
-ReplaySources make_replay_sources(const ReplayOptions& options, std::string& error) {
-  ReplaySources out;
-  recording::McapReader reader;
-  if (!reader.open(options.path, error)) return out;
-  // Channels and metadata come from the summary; a file cut short has none, so scan it.
+namespace {
+
+/// Opens a recording with its channels and metadata known: they come from the summary, and a
+/// file cut short has none, so it is scanned to the damage.
+bool open_with_channels(const std::string& path, recording::McapReader& reader,
+                        std::string& error) {
+  if (!reader.open(path, error)) return false;
   if (reader.channels().empty() || reader.metadata().empty()) {
     recording::McapMessage message;
     while (reader.next(message)) {
     }
   }
+  return true;
+}
+
+std::string metadata_value(const recording::McapChannelRecord& channel, std::string_view key) {
+  const auto it = channel.metadata.find(std::string(key));
+  return it == channel.metadata.end() ? std::string() : it->second;
+}
+
+constexpr std::string_view kConfigKey = "posed.config";
+
+}  // namespace
+
+bool read_recorded_config(const std::string& path, std::string& yaml, std::string& error) {
+  recording::McapReader reader;
+  if (!open_with_channels(path, reader, error)) return false;
+  yaml.clear();
+  for (const auto& [id, channel] : reader.channels()) {
+    const std::string config = metadata_value(channel, kConfigKey);
+    if (config.empty()) continue;
+    // Every raw channel carries the same text; the IMU's, which every replay needs, is preferred.
+    if (yaml.empty() || metadata_value(channel, recording::raw::kStreamKey) == "imu") yaml = config;
+  }
+  if (yaml.empty()) {
+    error = path +
+            ": no recorded configuration (channel metadata posed.config): only posed --record and "
+            "posectl record write one, not posectl import or posectl sim; give --config instead";
+    return false;
+  }
+  return true;
+}
+
+ReplaySources make_replay_sources(const ReplayOptions& options, std::string& error) {
+  ReplaySources out;
+  recording::McapReader reader;
+  if (!open_with_channels(options.path, reader, error)) return out;
   std::set<std::string> streams;
   for (const auto& [id, channel] : reader.channels()) {
     if (!recording::raw::is_stream_channel(channel.message_encoding, channel.metadata)) continue;
@@ -62,7 +99,21 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     return std::make_unique<recording::McapReplaySource>(std::move(c));
   };
   out.built.sources.imu = make("imu");
-  if (streams.count("lidar")) out.built.sources.lidar = make("lidar");
+  if (streams.count("lidar")) {
+    out.built.sources.lidar = make("lidar");
+    if (options.recorded_config) {
+      // The calibration file's text as it was when recorded (empty: the built-in table was used).
+      for (const auto& [id, channel] : reader.channels()) {
+        if (metadata_value(channel, recording::raw::kStreamKey) != "lidar") continue;
+        const std::string text = metadata_value(channel, "posed.lidar.calibration_text");
+        if (text.empty()) continue;
+        out.built.sources.lidar_calibration_text = text;
+        out.built.sources.lidar_calibration_name =
+            options.path + " (recorded " + metadata_value(channel, "posed.lidar.calibration") + ")";
+        break;
+      }
+    }
+  }
   // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp).
   // Other streams (the D435i's depth, a second IMU) have no stage: listed, said once in the log,
   // never read.

@@ -19,6 +19,9 @@ struct ReplayOptions {
   /// replay only this much of it; 0 = to the end [s]
   double duration_s = 0;
   bool loop = false;
+  /// replaying with the configuration the recording was made with (--recorded-config): the lidar
+  /// packets are decoded with the calibration recorded beside them, not lidar.calibration's file
+  bool recorded_config = false;
 };
 
 struct ReplaySources {
@@ -32,5 +35,11 @@ struct ReplaySources {
 
 /// On failure the sources are empty and `error` names the file and the problem.
 ReplaySources make_replay_sources(const ReplayOptions& options, std::string& error);
+
+/// The effective configuration a recording was made with (`posed --record` and `posectl record`
+/// write it into every raw channel's metadata as posed.config; the IMU channel's is taken), as
+/// YAML the config loader reads. False with `error` naming the file when it has none (an import,
+/// a simulation) or cannot be read.
+bool read_recorded_config(const std::string& path, std::string& yaml, std::string& error);
 
 }  // namespace posed::pipeline

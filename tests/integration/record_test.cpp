@@ -9,10 +9,12 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <thread>
 
 #include "drivers/recording/mcap_reader.hpp"
+#include "drivers/velodyne/calibration.hpp"
 #include "tests/integration/hil_helpers.hpp"
 #include "tests/integration/posed_process.hpp"
 #include "tests/unit/velodyne/packet_builder.hpp"
@@ -200,6 +202,104 @@ TEST(PosectlRecord, ABadConfigIsRefusedNamingTheKey) {
   ASSERT_EQ(record.wait_for_exit(10s), 2);
   EXPECT_NE(record.err().find("imu.sourcee"), std::string::npos) << record.err();
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.mcap")));
+}
+
+/// The VLP-32C's manual table as a ros-drivers calibration YAML file's text.
+std::string vlp32c_calibration_yaml() {
+  const auto table = drivers::velodyne::builtin_calibration(drivers::velodyne::ProductId::kVlp32c);
+  std::string yaml = "num_lasers: 32\ndistance_resolution: 0.004\nlasers:\n";
+  for (std::size_t i = 0; i < table.lasers.size(); ++i) {
+    char line[160];
+    std::snprintf(line, sizeof line,
+                  "  - {laser_id: %zu, rot_correction: %.9f, vert_correction: %.9f}\n", i,
+                  table.lasers[i].rot_correction_rad, table.lasers[i].vert_correction_rad);
+    yaml += line;
+  }
+  return yaml;
+}
+
+// A laptop replays a robot's recording with the configuration the robot ran: settings and the
+// lidar calibration come from the file (the calibration file itself is gone), DDS from the
+// laptop's --config.
+TEST(PosedReplay, RecordedConfigReplaysAsTheRobotRanWithTheRecordedCalibration) {
+  TempDir robot;
+  const std::uint16_t data_port = free_udp_port();
+  const std::uint16_t position_port = free_udp_port();
+  const std::string calibration = robot.write("vlp32c.yaml", vlp32c_calibration_yaml());
+  const std::string robot_config =
+      robot.write("posed.yaml", dds_config(source_dir()) +
+                                    "imu:\n  source: synthetic\n"
+                                    "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n  rate_hz: 250\n"
+                                    "lidar:\n  enabled: true\n  source: udp\n  address: 127.0.0.1\n"
+                                    "  calibration: vlp32c.yaml\n  data_port: " +
+                                    std::to_string(data_port) +
+                                    "\n  position_port: " + std::to_string(position_port) + "\n" +
+                                    "estimator:\n  init_static_s: 0.5\n");
+  const std::string recording = robot.file("run.mcap");
+  {
+    PosedProcess record({build_dir() + "/tools/posectl/posectl", "record", "-o", recording,
+                         "--config", robot_config},
+                        {}, robot);
+    const auto ready_by = std::chrono::steady_clock::now() + 20s;
+    while (record.err().find("recording imu, lidar") == std::string::npos &&
+           std::chrono::steady_clock::now() < ready_by) {
+      ASSERT_FALSE(record.wait_for_exit(20ms).has_value()) << record.err();
+    }
+    LidarSender sender;
+    sender.run(data_port, position_port, 1500);
+    std::this_thread::sleep_for(500ms);
+    record.signal(SIGINT);
+    ASSERT_EQ(record.wait_for_exit(30s), 0) << record.err();
+  }
+  std::filesystem::remove(calibration);
+
+  TempDir laptop;
+  const std::string laptop_config = laptop.write("local.yaml", dds_config(source_dir()));
+  const std::string posed = build_dir() + "/daemon/posed";
+  // What it runs with: the robot's settings, the laptop's DDS.
+  {
+    PosedProcess print({posed, "--replay", recording, "--recorded-config", "--config",
+                        laptop_config, "--print-config"},
+                       {}, laptop);
+    ASSERT_EQ(print.wait_for_exit(30s), 0) << print.err();
+    const std::string printed = print.out();
+    EXPECT_NE(printed.find("data_port: " + std::to_string(data_port)), std::string::npos)
+        << printed;
+    EXPECT_NE(printed.find("rate_hz: 250"), std::string::npos) << printed;
+    EXPECT_NE(printed.find("cyclonedds-loopback.xml"), std::string::npos) << printed;
+  }
+  // The laptop's own config has no such calibration file: a plain replay cannot decode.
+  {
+    PosedProcess plain({posed, "--replay", recording, "--config", robot_config, "--max-speed",
+                        "--wait-subscribers", "0"},
+                       {}, laptop);
+    ASSERT_NE(plain.wait_for_exit(60s), 0);
+    EXPECT_NE(plain.err().find("vlp32c.yaml"), std::string::npos) << plain.err();
+  }
+  PosedProcess replay({posed, "--replay", recording, "--recorded-config", "--config", laptop_config,
+                       "--max-speed", "--wait-subscribers", "0"},
+                      {}, laptop);
+  ASSERT_EQ(replay.wait_for_exit(60s), 0) << replay.err();
+  EXPECT_NE(replay.err().find("configuration as recorded in " + recording), std::string::npos)
+      << replay.err();
+  EXPECT_NE(replay.err().find("(recorded " + calibration + ")"), std::string::npos) << replay.err();
+  EXPECT_EQ(number_after(replay.out(), "  lidar               "), 1500) << replay.out();
+}
+
+TEST(PosedReplay, RecordedConfigOfARecordingWithoutOneIsRefusedNamingTheFile) {
+  TempDir dir;
+  const std::string simulated = dir.file("sim.mcap");
+  PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "room",
+                    "--duration", "0.5", "--seed", "1", "--no-cameras", "--config",
+                    source_dir() + "/config/posed.yaml", "-o", simulated},
+                   {}, dir);
+  ASSERT_EQ(sim.wait_for_exit(60s), 0) << sim.err();
+  PosedProcess replay(
+      {build_dir() + "/daemon/posed", "--replay", simulated, "--recorded-config", "--max-speed"},
+      {}, dir);
+  ASSERT_EQ(replay.wait_for_exit(30s), 2) << replay.err();
+  EXPECT_NE(replay.err().find(simulated + ": no recorded configuration"), std::string::npos)
+      << replay.err();
 }
 
 }  // namespace record_test
