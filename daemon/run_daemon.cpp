@@ -387,13 +387,20 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   std::printf("  estimator           %s, last mode %s\n", pipe.estimator_description().c_str(),
               std::string(to_string(st.mode)).c_str());
   for (const auto& s : st.streams) {
+    // Chunks nothing could decode are a configuration problem, not damaged data: said apart.
+    char undecodable[80] = "";
+    if (s.undecodable > 0) {
+      std::snprintf(undecodable, sizeof undecodable, " (%llu with no decoder configured)",
+                    static_cast<unsigned long long>(s.undecodable));
+    }
     std::printf(
-        "  %-19s %llu decoded (%.1f Hz mean), %llu malformed, %llu dropped; clock %s, "
+        "  %-19s %llu decoded (%.1f Hz mean), %llu malformed%s, %llu dropped; clock %s, "
         "offset %.3f ms, drift %.1f ppm\n",
         s.name.c_str(), static_cast<unsigned long long>(s.decoded),
         run_s > 0 ? static_cast<double>(s.decoded) / run_s : 0.0,
-        static_cast<unsigned long long>(s.malformed), static_cast<unsigned long long>(s.dropped),
-        s.clock_state.c_str(), static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
+        static_cast<unsigned long long>(s.malformed), undecodable,
+        static_cast<unsigned long long>(s.dropped), s.clock_state.c_str(),
+        static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
   }
   if (replaying) {
     std::printf("  replayed            %s (%s)\n", options.replay.path.c_str(),

@@ -19,6 +19,9 @@ struct StreamStatus {
   std::uint64_t decoded = 0;    ///< measurements decoded
   std::uint64_t dropped = 0;    ///< measurements dropped by the queue policy
   std::uint64_t malformed = 0;  ///< frames rejected by the decoder (CRC, truncation, unknown)
+  /// of `malformed`, those no decoder was there for (an unknown wire format, a CAN IMU without
+  /// imu.can_mapping): a configuration problem rather than damaged data
+  std::uint64_t undecodable = 0;
   std::int64_t clock_offset_ns = 0;  ///< host minus device time [ns]
   double clock_drift_ppm = 0;        ///< device clock rate error [ppm]
   double clock_jitter_ns = 0;        ///< spread of arrival delays [ns]

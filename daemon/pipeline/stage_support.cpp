@@ -21,8 +21,8 @@ void fill_stream_status(StreamStatus& out, const StreamCounters& counters, HostT
                         bool live) {
   out.received = counters.received.load(std::memory_order_relaxed);
   out.decoded = counters.decoded.load(std::memory_order_relaxed);
-  out.malformed = counters.malformed.load(std::memory_order_relaxed) +
-                  counters.undecodable.load(std::memory_order_relaxed);
+  out.undecodable = counters.undecodable.load(std::memory_order_relaxed);
+  out.malformed = counters.malformed.load(std::memory_order_relaxed) + out.undecodable;
   out.dropped = counters.dropped.load(std::memory_order_relaxed);
   const ClockSyncStatus clock = counters.clock();
   out.clock_offset_ns = clock.offset.ns;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <thread>
@@ -104,6 +105,28 @@ TEST(CanReplay, ACandumpImportReplaysIntoTheFusionCore) {
     EXPECT_EQ(posed.err().find("no decoder for wire format"), std::string::npos) << posed.err();
     EXPECT_EQ(posed.err().find("imu clock: reset"), std::string::npos)
         << "the counter's wrap is not a reset: " << posed.err();
+  }
+
+  // Without imu.can_mapping nothing says which frames are the IMU's: every frame is counted as
+  // malformed, said apart as a configuration problem, and the log says where a mapping comes from.
+  {
+    const std::string unmapped =
+        dir.write("unmapped.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
+                                       "\n  cyclonedds_config: " + source_dir() +
+                                       "/config/cyclonedds-loopback.xml\n");
+    PosedProcess posed({build_dir() + "/daemon/posed", "--config", unmapped, "--replay", imported,
+                        "--max-speed", "--wait-subscribers", "0"},
+                       {}, dir);
+    posed.wait_for_exit(120s);
+    const std::string log_text = candump_log(mapping);  // one frame per line
+    const std::string frames = std::to_string(std::count(log_text.begin(), log_text.end(), '\n'));
+    EXPECT_NE(posed.out().find("imu                 0 decoded"), std::string::npos) << posed.out();
+    EXPECT_NE(
+        posed.out().find(" " + frames + " malformed (" + frames + " with no decoder configured)"),
+        std::string::npos)
+        << posed.out();
+    EXPECT_NE(posed.err().find("no imu.can_mapping"), std::string::npos) << posed.err();
+    EXPECT_NE(posed.err().find("--recorded-config"), std::string::npos) << posed.err();
   }
 
   // The same replay in process (make_replay_sources + Pipeline, as posed --replay builds it), to
