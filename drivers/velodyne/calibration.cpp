@@ -8,8 +8,6 @@
 namespace posed::drivers::velodyne {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
-
 // VLP-32C user manual table 9-2, by laser id: vertical angle [deg] and azimuth offset [deg].
 constexpr std::array<double, 32> kVlp32cElevationDeg = {
     -25.0,  -1.0,   -1.667, -15.639, -11.31, 0.0,    -0.667, -8.843, -7.254, 0.333,  -0.333,

@@ -5,12 +5,16 @@
 // VLP-32C laser whose manual azimuth offset is +1.4° has rot_correction −1.4°).
 
 #include <cstdint>
+#include <numbers>
 #include <string>
 #include <vector>
 
 #include "drivers/velodyne/packet_format.hpp"
 
 namespace posed::drivers::velodyne {
+
+/// Calibration tables and files give angles in degrees.
+inline constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 struct LaserCorrection {
   /// azimuth correction, subtracted from the firing's azimuth [rad]

@@ -13,8 +13,6 @@
 namespace posed::drivers::velodyne {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
-
 std::string where(std::string_view name, int line) {
   std::string s = "calibration file ";
   s += name;
