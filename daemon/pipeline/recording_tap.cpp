@@ -4,8 +4,11 @@
 #include <sstream>
 
 #include "daemon/config/config_loader.hpp"
+#include "drivers/recording/raw_channels.hpp"
 
 namespace posed::pipeline {
+
+namespace raw = drivers::recording::raw;
 
 namespace {
 
@@ -45,7 +48,8 @@ drivers::ReadStatus RecordingTap::read(drivers::RawChunk& chunk, Duration timeou
 std::map<std::string, std::string> recording_metadata(const config::PosedConfig& config,
                                                       std::string_view stream) {
   // Every channel carries the effective configuration: a recording says how it was made.
-  std::map<std::string, std::string> md{{"posed.config", config::print_config(config)}};
+  std::map<std::string, std::string> md{
+      {std::string(raw::kConfigKey), config::print_config(config)}};
   if (stream == "imu") {
     md["posed.imu.source"] = config.imu.source;
     if (config.imu.source == "can") {
@@ -57,8 +61,8 @@ std::map<std::string, std::string> recording_metadata(const config::PosedConfig&
     }
   } else if (stream == "lidar") {
     md["posed.lidar.address"] = config.lidar.address;
-    md["posed.lidar.calibration"] = config.lidar.calibration;
-    md["posed.lidar.calibration_text"] = read_text_file(config.lidar.calibration);
+    md[std::string(raw::kLidarCalibrationKey)] = config.lidar.calibration;
+    md[std::string(raw::kLidarCalibrationTextKey)] = read_text_file(config.lidar.calibration);
   } else if (stream == "visible" || stream == "thermal") {
     const config::CameraSection& camera =
         stream == "visible" ? config.visible_camera : config.thermal_camera;

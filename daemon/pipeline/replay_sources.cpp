@@ -11,6 +11,7 @@
 namespace posed::pipeline {
 
 namespace recording = drivers::recording;
+namespace raw = drivers::recording::raw;
 
 namespace {
 
@@ -27,13 +28,6 @@ bool open_with_channels(const std::string& path, recording::McapReader& reader,
   return true;
 }
 
-std::string metadata_value(const recording::McapChannelRecord& channel, std::string_view key) {
-  const auto it = channel.metadata.find(std::string(key));
-  return it == channel.metadata.end() ? std::string() : it->second;
-}
-
-constexpr std::string_view kConfigKey = "posed.config";
-
 }  // namespace
 
 bool read_recorded_config(const std::string& path, std::string& yaml, std::string& error) {
@@ -41,10 +35,11 @@ bool read_recorded_config(const std::string& path, std::string& yaml, std::strin
   if (!open_with_channels(path, reader, error)) return false;
   yaml.clear();
   for (const auto& [id, channel] : reader.channels()) {
-    const std::string config = metadata_value(channel, kConfigKey);
+    const std::string config = raw::metadata_value(channel.metadata, raw::kConfigKey);
     if (config.empty()) continue;
     // Every raw channel carries the same text; the IMU's, which every replay needs, is preferred.
-    if (yaml.empty() || metadata_value(channel, recording::raw::kStreamKey) == "imu") yaml = config;
+    if (yaml.empty() || raw::metadata_value(channel.metadata, raw::kStreamKey) == "imu")
+      yaml = config;
   }
   if (yaml.empty()) {
     error = path +
@@ -104,12 +99,14 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     if (options.recorded_config) {
       // The calibration file's text as it was when recorded (empty: the built-in table was used).
       for (const auto& [id, channel] : reader.channels()) {
-        if (metadata_value(channel, recording::raw::kStreamKey) != "lidar") continue;
-        const std::string text = metadata_value(channel, "posed.lidar.calibration_text");
+        if (raw::metadata_value(channel.metadata, raw::kStreamKey) != "lidar") continue;
+        const std::string text =
+            raw::metadata_value(channel.metadata, raw::kLidarCalibrationTextKey);
         if (text.empty()) continue;
         out.built.sources.lidar_calibration_text = text;
         out.built.sources.lidar_calibration_name =
-            options.path + " (recorded " + metadata_value(channel, "posed.lidar.calibration") + ")";
+            options.path + " (recorded " +
+            raw::metadata_value(channel.metadata, raw::kLidarCalibrationKey) + ")";
         break;
       }
     }

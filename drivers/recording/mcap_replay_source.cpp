@@ -10,19 +10,14 @@
 
 namespace posed::drivers::recording {
 
-namespace {
-std::string meta(const McapChannelRecord& c, std::string_view key) {
-  const auto it = c.metadata.find(std::string(key));
-  return it == c.metadata.end() ? std::string() : it->second;
-}
-}  // namespace
+namespace {}  // namespace
 
 McapReplaySource::McapReplaySource(McapReplayConfig config)
     : config_(std::move(config)), name_(config_.name.empty() ? config_.stream : config_.name) {}
 
 bool McapReplaySource::wanted(const McapChannelRecord& c) const {
   return raw::is_stream_channel(c.message_encoding, c.metadata) &&
-         meta(c, raw::kStreamKey) == config_.stream;
+         raw::metadata_value(c.metadata, raw::kStreamKey) == config_.stream;
 }
 
 bool McapReplaySource::open(std::string& error) {
@@ -33,13 +28,14 @@ bool McapReplaySource::open(std::string& error) {
     bool found = false;
     for (const auto& [id, c] : reader_.channels()) {
       if (raw::is_stream_channel(c.message_encoding, c.metadata)) {
-        streams.insert(meta(c, raw::kStreamKey));
+        streams.insert(raw::metadata_value(c.metadata, raw::kStreamKey));
       }
       if (wanted(c)) {
         found = true;
         std::lock_guard lock(info_mutex_);
-        channels_[id] = {raw::parse_source_channel(meta(c, raw::kSourceChannelKey)), c.topic,
-                         meta(c, raw::kWireFormatKey), c.metadata};
+        channels_[id] = {
+            raw::parse_source_channel(raw::metadata_value(c.metadata, raw::kSourceChannelKey)),
+            c.topic, raw::metadata_value(c.metadata, raw::kWireFormatKey), c.metadata};
       }
     }
     if (!found) {
@@ -94,8 +90,10 @@ bool McapReplaySource::fetch() {
     {
       std::lock_guard lock(info_mutex_);
       if (channels_.find(id) == channels_.end()) {
-        channels_[id] = {raw::parse_source_channel(meta(*m.channel, raw::kSourceChannelKey)),
-                         m.channel->topic, meta(*m.channel, raw::kWireFormatKey),
+        channels_[id] = {raw::parse_source_channel(
+                             raw::metadata_value(m.channel->metadata, raw::kSourceChannelKey)),
+                         m.channel->topic,
+                         raw::metadata_value(m.channel->metadata, raw::kWireFormatKey),
                          m.channel->metadata};
       }
     }

@@ -36,6 +36,18 @@ inline constexpr std::string_view kMessageEncoding = "posed-raw";
 inline constexpr std::string_view kStreamKey = "posed.stream";
 inline constexpr std::string_view kWireFormatKey = "posed.wire_format";
 inline constexpr std::string_view kSourceChannelKey = "posed.source_channel";
+/// what posed --record and posectl record add to every raw channel: the effective configuration
+/// (print_config's YAML) and, on the lidar's, the calibration file's path and text
+inline constexpr std::string_view kConfigKey = "posed.config";
+inline constexpr std::string_view kLidarCalibrationKey = "posed.lidar.calibration";
+inline constexpr std::string_view kLidarCalibrationTextKey = "posed.lidar.calibration_text";
+
+/// A channel's metadata value for `key`; empty when the channel has none.
+inline std::string metadata_value(const std::map<std::string, std::string>& metadata,
+                                  std::string_view key) {
+  const auto it = metadata.find(std::string(key));
+  return it == metadata.end() ? std::string() : it->second;
+}
 
 // The wire formats (drivers/common/wire_format.hpp) under the names recordings use.
 inline constexpr std::string_view kWireA9Serial = wire::kA9Serial;

@@ -11,14 +11,7 @@ namespace posed::hil {
 
 namespace raw = drivers::recording::raw;
 
-namespace {
-
-std::string meta(const drivers::recording::McapChannelRecord& c, std::string_view key) {
-  const auto it = c.metadata.find(std::string(key));
-  return it == c.metadata.end() ? std::string() : it->second;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::string_view to_string(HilOutput output) {
   switch (output) {
@@ -57,9 +50,10 @@ bool HilPlaylist::open(const HilPlaylistOptions& options, std::string& error) {
     HilChannel h;
     h.id = id;
     h.topic = c.topic;
-    h.stream = meta(c, raw::kStreamKey);
-    h.wire_format = meta(c, raw::kWireFormatKey);
-    h.source_channel = raw::parse_source_channel(meta(c, raw::kSourceChannelKey));
+    h.stream = raw::metadata_value(c.metadata, raw::kStreamKey);
+    h.wire_format = raw::metadata_value(c.metadata, raw::kWireFormatKey);
+    h.source_channel =
+        raw::parse_source_channel(raw::metadata_value(c.metadata, raw::kSourceChannelKey));
     h.output = output_for_wire_format(h.wire_format);
     h.sent = h.output == HilOutput::kSerial ? options_.serial
                                             : h.output != HilOutput::kNone && options_.udp;

@@ -21,11 +21,6 @@ namespace rec = drivers::recording;
 
 namespace {
 
-std::string meta(const rec::McapChannelRecord& c, std::string_view key) {
-  const auto it = c.metadata.find(std::string(key));
-  return it == c.metadata.end() ? std::string() : it->second;
-}
-
 unsigned long long ull(std::uint64_t v) { return static_cast<unsigned long long>(v); }
 
 /// "2024-06-01 12:00:00.000 UTC"
@@ -48,8 +43,9 @@ void print_channel(const rec::McapChannelStats& s, const rec::McapInspection& r,
               c.schema_id == 0 ? "no schema" : ("schema " + s.schema_name).c_str());
   if (c.message_encoding == rec::raw::kMessageEncoding) {
     std::printf("; stream %s, wire format %s, source channel %s",
-                meta(c, rec::raw::kStreamKey).c_str(), meta(c, rec::raw::kWireFormatKey).c_str(),
-                meta(c, rec::raw::kSourceChannelKey).c_str());
+                rec::raw::metadata_value(c.metadata, rec::raw::kStreamKey).c_str(),
+                rec::raw::metadata_value(c.metadata, rec::raw::kWireFormatKey).c_str(),
+                rec::raw::metadata_value(c.metadata, rec::raw::kSourceChannelKey).c_str());
   }
   std::printf("\n");
   if (s.messages == 0) {
