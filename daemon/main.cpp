@@ -77,26 +77,26 @@ int main(int argc, char** argv) noexcept try {
                 posed::version_string().data());
     return 0;
   }
-  auto loaded = posed::config::load_config_file(options.config_path);
-  if (options.replay.recorded_config) {
+  posed::config::LoadResult loaded;
+  if (!options.replay.recorded_config) {
+    loaded = posed::config::load_config_file(options.config_path);
+  } else {
     // The recording's configuration, with this machine's DDS settings: --config's, or the
     // defaults when none was given (the robot's network settings rarely fit a laptop).
-    const bool local_config_given = config_option->count() > 0;
-    if (!local_config_given) loaded.errors.clear();
     std::string yaml, error;
     if (!posed::pipeline::read_recorded_config(options.replay.path, yaml, error)) {
       std::fprintf(stderr, "posed: %s\n", error.c_str());
       return 2;
     }
-    auto recorded =
+    loaded =
         posed::config::load_config_text(yaml, options.replay.path + " (recorded configuration)");
-    if (loaded.ok() && recorded.ok()) {
-      recorded.config.dds =
-          local_config_given ? loaded.config.dds : posed::config::default_config().dds;
+    if (config_option->count() > 0) {
+      const auto local = posed::config::load_config_file(options.config_path);
+      loaded.errors.insert(loaded.errors.begin(), local.errors.begin(), local.errors.end());
+      loaded.config.dds = local.config.dds;
+    } else {
+      loaded.config.dds = posed::config::default_config().dds;
     }
-    if (!loaded.ok())
-      recorded.errors.insert(recorded.errors.begin(), loaded.errors.begin(), loaded.errors.end());
-    loaded = std::move(recorded);
   }
   if (!loaded.ok()) {
     std::fprintf(stderr, "posed: invalid configuration:\n%s", loaded.error_text().c_str());

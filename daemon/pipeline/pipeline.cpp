@@ -130,14 +130,16 @@ bool Pipeline::start(std::string& error) {
     return false;
   }
   drivers::velodyne::Calibration calibration;  // empty: the manual's table for the model seen
-  if (sources_.lidar && !sources_.lidar_calibration_text.empty()) {
-    if (!drivers::velodyne::parse_calibration_text(
-            sources_.lidar_calibration_text, sources_.lidar_calibration_name, calibration, error)) {
-      return false;
-    }
-  } else if (sources_.lidar && !config_.lidar.calibration.empty() &&
-             !drivers::velodyne::load_calibration(config_.lidar.calibration, calibration, error)) {
-    return false;
+  if (sources_.lidar) {
+    // The calibration recorded with the replayed packets, else the configured file, else none.
+    const bool loaded = !sources_.lidar_calibration_text.empty()
+                            ? drivers::velodyne::parse_calibration_text(
+                                  sources_.lidar_calibration_text, sources_.lidar_calibration_name,
+                                  calibration, error)
+                            : config_.lidar.calibration.empty() ||
+                                  drivers::velodyne::load_calibration(config_.lidar.calibration,
+                                                                      calibration, error);
+    if (!loaded) return false;
   }
   std::size_t stage = 0;
   imu_stage_ = std::make_unique<ImuStage>(config_, *sources_.imu, imu_queue_, fusion_ready_,
