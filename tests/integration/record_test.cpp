@@ -60,6 +60,16 @@ struct LidarSender {
   }
 };
 
+/// Waits until `posectl record` says it records the IMU and the lidar: its sockets are open.
+void wait_until_recording(PosedProcess& record) {
+  const auto ready_by = std::chrono::steady_clock::now() + 20s;
+  while (record.err().find("recording imu, lidar") == std::string::npos &&
+         std::chrono::steady_clock::now() < ready_by) {
+    ASSERT_FALSE(record.wait_for_exit(20ms).has_value()) << record.err();
+  }
+  ASSERT_NE(record.err().find("recording imu, lidar"), std::string::npos) << record.err();
+}
+
 std::string meta(const rec::McapChannelRecord& c, const std::string& key) {
   const auto it = c.metadata.find(key);
   return it == c.metadata.end() ? std::string() : it->second;
@@ -83,13 +93,7 @@ TEST(PosectlRecord, RecordsTheSourcesUntilSigintAndPosedReplaysTheFile) {
   PosedProcess record(
       {build_dir() + "/tools/posectl/posectl", "record", "-o", recording, "--config", config}, {},
       record_dir);
-  // The sockets are open once it says what it records.
-  const auto ready_by = std::chrono::steady_clock::now() + 20s;
-  while (record.err().find("recording imu, lidar") == std::string::npos &&
-         std::chrono::steady_clock::now() < ready_by) {
-    ASSERT_FALSE(record.wait_for_exit(20ms).has_value()) << record.err();
-  }
-  ASSERT_NE(record.err().find("recording imu, lidar"), std::string::npos) << record.err();
+  ASSERT_NO_FATAL_FAILURE(wait_until_recording(record));
 
   LidarSender sender;
   sender.run(data_port, position_port, 4500);  // 3 s
@@ -240,11 +244,7 @@ TEST(PosedReplay, RecordedConfigReplaysAsTheRobotRanWithTheRecordedCalibration) 
     PosedProcess record({build_dir() + "/tools/posectl/posectl", "record", "-o", recording,
                          "--config", robot_config},
                         {}, robot);
-    const auto ready_by = std::chrono::steady_clock::now() + 20s;
-    while (record.err().find("recording imu, lidar") == std::string::npos &&
-           std::chrono::steady_clock::now() < ready_by) {
-      ASSERT_FALSE(record.wait_for_exit(20ms).has_value()) << record.err();
-    }
+    ASSERT_NO_FATAL_FAILURE(wait_until_recording(record));
     LidarSender sender;
     sender.run(data_port, position_port, 1500);
     std::this_thread::sleep_for(500ms);

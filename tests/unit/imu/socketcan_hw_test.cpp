@@ -13,21 +13,15 @@
 #include <cstring>
 
 #include "drivers/imu/socketcan_source.hpp"
+#include "tests/common/socketcan_test.hpp"
 
 namespace posed::drivers::can {
 namespace {
 
 TEST(SocketCanSource, ReceivesFramesOnALiveInterface) {
-  const int probe = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
-  if (probe < 0) {
-    GTEST_SKIP() << "socket(PF_CAN) failed (" << std::strerror(errno)
-                 << "): this kernel/container has no SocketCAN";
-  }
-  ::close(probe);
-  const char* env = std::getenv("POSED_CAN_IFACE");
-  const std::string iface = env != nullptr ? env : "vcan0";
-  if (::if_nametoindex(iface.c_str()) == 0) {
-    GTEST_SKIP() << "CAN interface " << iface << " not present (set POSED_CAN_IFACE)";
+  std::string iface;
+  if (const std::string why_not = test::live_can_interface(iface); !why_not.empty()) {
+    GTEST_SKIP() << why_not;
   }
   SocketCanConfig cfg;
   cfg.interface = iface;
@@ -37,12 +31,8 @@ TEST(SocketCanSource, ReceivesFramesOnALiveInterface) {
   ASSERT_TRUE(source.open(error)) << error;
 
   // Send through a second raw socket on the same interface (vcan loops frames back).
-  const int tx = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
-  ASSERT_GE(tx, 0);
-  sockaddr_can addr{};
-  addr.can_family = AF_CAN;
-  addr.can_ifindex = static_cast<int>(::if_nametoindex(iface.c_str()));
-  ASSERT_EQ(::bind(tx, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const int tx = test::open_can_sender(iface);
+  ASSERT_GE(tx, 0) << std::strerror(errno);
   for (canid_t id : {0x181u, 0x180u}) {  // 0x181 is filtered out by the kernel
     can_frame f{};
     f.can_id = id;

@@ -19,21 +19,15 @@
 #include "daemon/pipeline/imu_stage.hpp"
 #include "daemon/pipeline/source_factory.hpp"
 #include "tests/common/can_imu_encoder.hpp"
+#include "tests/common/socketcan_test.hpp"
 
 namespace posed::pipeline {
 namespace {
 
 TEST(ImuStageCanLive, SamplesFromALiveInterface) {
-  const int probe = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
-  if (probe < 0) {
-    GTEST_SKIP() << "socket(PF_CAN) failed (" << std::strerror(errno)
-                 << "): this kernel/container has no SocketCAN";
-  }
-  ::close(probe);
-  const char* env = std::getenv("POSED_CAN_IFACE");
-  const std::string iface = env != nullptr ? env : "vcan0";
-  if (::if_nametoindex(iface.c_str()) == 0) {
-    GTEST_SKIP() << "CAN interface " << iface << " not present (set POSED_CAN_IFACE)";
+  std::string iface;
+  if (const std::string why_not = test::live_can_interface(iface); !why_not.empty()) {
+    GTEST_SKIP() << why_not;
   }
   const char* src = std::getenv("POSED_SOURCE_DIR");
   ASSERT_NE(src, nullptr);
@@ -64,12 +58,8 @@ TEST(ImuStageCanLive, SamplesFromALiveInterface) {
     }
   } joiner{source, thread};
 
-  const int tx = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
-  ASSERT_GE(tx, 0);
-  sockaddr_can addr{};
-  addr.can_family = AF_CAN;
-  addr.can_ifindex = static_cast<int>(::if_nametoindex(iface.c_str()));
-  ASSERT_EQ(::bind(tx, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const int tx = test::open_can_sender(iface);
+  ASSERT_GE(tx, 0) << std::strerror(errno);
   const Eigen::Vector3d gyro(0.1, -0.2, 0.3), force(0, 0, 9.80665);
   constexpr int kSamples = 20;
   for (int i = 0; i < kSamples; ++i) {
