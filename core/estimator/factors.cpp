@@ -115,11 +115,14 @@ LidarPoseFactor::LidarPoseFactor(const Eigen::Isometry3d& T_map_lidar,
       R_meas_(T_map_lidar.linear()),
       p_il_(T_imu_lidar.translation()),
       R_il_(T_imu_lidar.linear()) {
+  sqrt_info_ = sqrt_information(information);
+}
+
+Eigen::Matrix<double, 6, 6> sqrt_information(const Eigen::Matrix<double, 6, 6>& information) {
   // information = V diag(l) Vᵀ, possibly singular: sqrt = diag(sqrt(l)) Vᵀ.
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(
       0.5 * (information + information.transpose()));
-  sqrt_info_ =
-      es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
+  return es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
 }
 
 bool LidarPoseFactor::Evaluate(double const* const* parameters, double* residuals,
@@ -140,6 +143,45 @@ bool LidarPoseFactor::Evaluate(double const* const* parameters, double* residual
     J.block<3, 3>(3, 0) = R_meas_T;
     J.block<3, 3>(3, 3) = -R_meas_T * R * skew(p_il_);
     pose_jacobian<6>(sqrt_info_ * J, parameters[0], jacobians[0]);
+  }
+  return true;
+}
+
+RelativePoseFactor::RelativePoseFactor(const Eigen::Isometry3d& T_i_j,
+                                       const Eigen::Matrix<double, 6, 6>& information)
+    : R_meas_(T_i_j.linear()),
+      p_meas_(T_i_j.translation()),
+      sqrt_info_(sqrt_information(information)) {}
+
+bool RelativePoseFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const Eigen::Map<const Eigen::Vector3d> pi(parameters[0]), pj(parameters[1]);
+  const Mat3 Ri =
+      Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized().toRotationMatrix();
+  const Mat3 Rj =
+      Eigen::Map<const Eigen::Quaterniond>(parameters[1] + 3).normalized().toRotationMatrix();
+  const Mat3 Rm_T = R_meas_.transpose();
+  const Eigen::Vector3d d_i = Ri.transpose() * (pj - pi);  // p_j in frame i
+  const Eigen::Vector3d r_rot = so3::log(Mat3(Rm_T * Ri.transpose() * Rj));
+  Eigen::Matrix<double, 6, 1> r;
+  r.head<3>() = r_rot;
+  r.tail<3>() = Rm_T * (d_i - p_meas_);
+  Eigen::Map<Eigen::Matrix<double, 6, 1>> out(residuals);
+  out = sqrt_info_ * r;
+  if (jacobians == nullptr) return true;
+  const Mat3 Jr_inv = so3::right_jacobian_inverse(r_rot);
+  if (jacobians[0] != nullptr) {  // pose i: R_i Exp(d) turns Ri⁻¹ Rj into Exp(-d) Ri⁻¹ Rj
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+    J.block<3, 3>(0, 3) = -Jr_inv * Rj.transpose() * Ri;
+    J.block<3, 3>(3, 0) = -Rm_T * Ri.transpose();
+    J.block<3, 3>(3, 3) = Rm_T * skew(d_i);
+    pose_jacobian<6>(sqrt_info_ * J, parameters[0], jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {  // pose j
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+    J.block<3, 3>(0, 3) = Jr_inv;
+    J.block<3, 3>(3, 0) = Rm_T * Ri.transpose();
+    pose_jacobian<6>(sqrt_info_ * J, parameters[1], jacobians[1]);
   }
   return true;
 }

@@ -48,4 +48,25 @@ class LidarPoseFactor final : public ceres::SizedCostFunction<6, 7> {
   Eigen::Matrix<double, 6, 6> sqrt_info_;
 };
 
+/// A relative motion of the IMU (base_link) from state i to state j, T_i_j = T_map_i⁻¹ T_map_j,
+/// measured by another sensor (a camera's frame-to-frame motion carried over to the IMU frame),
+/// with its information in the same right-perturbation (rotation, translation) convention:
+/// 6 residuals r = [Log(R_meas⁻¹ R_i⁻¹ R_j), R_meas⁻¹ (R_i⁻¹ (p_j - p_i) - p_meas)] (seed 002's
+/// VIO/TIO "between" factor).
+class RelativePoseFactor final : public ceres::SizedCostFunction<6, 7, 7> {
+ public:
+  RelativePoseFactor(const Eigen::Isometry3d& T_i_j,
+                     const Eigen::Matrix<double, 6, 6>& information);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Matrix3d R_meas_;
+  Eigen::Vector3d p_meas_;
+  Eigen::Matrix<double, 6, 6> sqrt_info_;
+};
+
+/// The square root of a (possibly singular) information matrix: S with Sᵀ S = information.
+Eigen::Matrix<double, 6, 6> sqrt_information(const Eigen::Matrix<double, 6, 6>& information);
+
 }  // namespace posed::estimator

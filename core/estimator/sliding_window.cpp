@@ -1,86 +1,50 @@
 #include "core/estimator/sliding_window.hpp"
 
 #include <ceres/problem.h>
-#include <ceres/sized_cost_function.h>
 #include <ceres/solver.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 
 #include "core/estimator/factors.hpp"
+#include "core/estimator/linearisation.hpp"
+#include "core/estimator/marginal_prior.hpp"
 #include "core/estimator/pose_manifold.hpp"
 
 namespace posed::estimator {
 namespace {
 
-using Vec15 = Eigen::Matrix<double, 15, 1>;
-using Mat15 = Eigen::Matrix<double, 15, 15>;
-
-const PoseManifold& pose_manifold() {
-  static const PoseManifold manifold;
+PoseManifold& pose_manifold() {
+  static PoseManifold manifold;
   return manifold;
 }
 
-/// A linear Gaussian prior on one state, r = J (x [-] x0) + r0, with x [-] x0 in the tangent space
-/// [dp, dtheta, v, b_g, b_a]: the start-up prior, and what marginalisation leaves behind.
-class StatePrior final : public ceres::SizedCostFunction<15, 7, 9> {
- public:
-  StatePrior(const double* pose0, const double* sb0, const Mat15& J, const Vec15& r0)
-      : J_(J), r0_(r0) {
-    std::copy(pose0, pose0 + 7, pose0_);
-    std::copy(sb0, sb0 + 9, sb0_);
-  }
-
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    Vec15 dx;
-    pose_manifold().Minus(parameters[0], pose0_, dx.data());
-    for (int i = 0; i < 9; ++i) dx(6 + i) = parameters[1][i] - sb0_[i];
-    Eigen::Map<Vec15> r(residuals);
-    r = J_ * dx + r0_;
-    if (jacobians == nullptr) return true;
-    if (jacobians[0] != nullptr) {
-      // d(x [-] x0)/dx ~ MinusJacobian at x (exact at x = x0; the prior is linear there anyway).
-      Eigen::Matrix<double, 6, 7, Eigen::RowMajor> minus;
-      pose_manifold().MinusJacobian(parameters[0], minus.data());
-      Eigen::Map<Eigen::Matrix<double, 15, 7, Eigen::RowMajor>> J0(jacobians[0]);
-      J0 = J_.leftCols<6>() * minus;
-    }
-    if (jacobians[1] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 15, 9, Eigen::RowMajor>> J1(jacobians[1]);
-      J1 = J_.rightCols<9>();
-    }
-    return true;
-  }
-
- private:
-  double pose0_[7];
-  double sb0_[9];
-  Mat15 J_;
-  Vec15 r0_;
-};
-
 void to_arrays(const imu::ImuState& s, double* pose, double* sb) {
-  {
-    Eigen::Map<Eigen::Vector3d> m(pose);
-    m = s.p_map_imu_m;
+  Eigen::Map<Eigen::Vector3d> p(pose), v(sb), bg(sb + 3), ba(sb + 6);
+  Eigen::Map<Eigen::Quaterniond> q(pose + 3);
+  p = s.p_map_imu_m;
+  q = s.q_map_imu.normalized();
+  v = s.v_map_mps;
+  bg = s.bias.gyro_radps;
+  ba = s.bias.accel_mps2;
+}
+
+/// H = Jᵀ J, b = Jᵀ r0 as a residual J, r0 (eigen-decomposition; modes below 1e-9 dropped).
+void as_residual(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::MatrixXd& J,
+                 Eigen::VectorXd& r0) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
+  const Eigen::VectorXd& lambda = es.eigenvalues();
+  Eigen::VectorXd sqrt_l = Eigen::VectorXd::Zero(lambda.size());
+  Eigen::VectorXd inv_sqrt_l = Eigen::VectorXd::Zero(lambda.size());
+  for (Eigen::Index i = 0; i < lambda.size(); ++i) {
+    if (lambda(i) > 1e-9) {
+      sqrt_l(i) = std::sqrt(lambda(i));
+      inv_sqrt_l(i) = 1.0 / sqrt_l(i);
+    }
   }
-  {
-    Eigen::Map<Eigen::Quaterniond> m(pose + 3);
-    m = s.q_map_imu.normalized();
-  }
-  {
-    Eigen::Map<Eigen::Vector3d> m(sb);
-    m = s.v_map_mps;
-  }
-  {
-    Eigen::Map<Eigen::Vector3d> m(sb + 3);
-    m = s.bias.gyro_radps;
-  }
-  {
-    Eigen::Map<Eigen::Vector3d> m(sb + 6);
-    m = s.bias.accel_mps2;
-  }
+  J = sqrt_l.asDiagonal() * es.eigenvectors().transpose();
+  r0 = inv_sqrt_l.asDiagonal() * es.eigenvectors().transpose() * b;
 }
 
 }  // namespace
@@ -100,49 +64,94 @@ imu::ImuState SlidingWindow::state(std::size_t i) const {
   return out;
 }
 
-void SlidingWindow::reset(const imu::ImuState& state, const Vec15& prior_sigma) {
+std::optional<std::size_t> SlidingWindow::index_of(std::uint64_t id) const {
+  if (states_.empty() || id < states_.front().id || id > states_.back().id) return std::nullopt;
+  // Ids are consecutive within the window (a reset starts a new run of them).
+  const std::size_t i = static_cast<std::size_t>(id - states_.front().id);
+  if (i >= states_.size() || states_[i].id != id) return std::nullopt;
+  return i;
+}
+
+double* SlidingWindow::block(const BlockRef& ref) {
+  const std::optional<std::size_t> i = index_of(ref.state_id);
+  if (!i) return nullptr;
+  State& s = states_[*i];
+  return ref.role == BlockRole::kPose ? s.pose : s.speed_bias;
+}
+
+void SlidingWindow::reset(const imu::ImuState& state,
+                          const Eigen::Matrix<double, 15, 1>& prior_sigma) {
   states_.clear();
+  factors_.clear();
   State& s = states_.emplace_back();
+  s.id = next_id_++;
   s.stamp = state.stamp;
   to_arrays(state, s.pose, s.speed_bias);
-  const Mat15 J = prior_sigma.cwiseInverse().asDiagonal();
-  prior_ = std::make_unique<StatePrior>(s.pose, s.speed_bias, J, Vec15::Zero());
+  std::vector<PriorBlock> blocks = {{7, std::vector<double>(s.pose, s.pose + 7)},
+                                    {9, std::vector<double>(s.speed_bias, s.speed_bias + 9)}};
+  const Eigen::MatrixXd J = prior_sigma.cwiseInverse().asDiagonal();
+  add_factor(FactorKind::kPrior,
+             std::make_unique<MarginalPrior>(std::move(blocks), J, Eigen::VectorXd::Zero(15)),
+             {{s.id, BlockRole::kPose}, {s.id, BlockRole::kSpeedBias}});
 }
 
 void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& pre,
                         const std::optional<LidarPose>& lidar) {
+  const std::optional<std::uint64_t> previous =
+      states_.empty() ? std::nullopt : std::optional<std::uint64_t>(states_.back().id);
   State& s = states_.emplace_back();
+  s.id = next_id_++;
   s.stamp = guess.stamp;
   to_arrays(guess, s.pose, s.speed_bias);
-  s.imu = std::make_unique<ImuFactor>(pre, config_.gravity_mps2, config_.noise);
   if (lidar) {
-    s.lidar = std::make_unique<LidarPoseFactor>(lidar->T_map_lidar, config_.T_imu_lidar,
-                                                lidar->information);
+    add_factor(FactorKind::kLidarPose,
+               std::make_unique<LidarPoseFactor>(lidar->T_map_lidar, config_.T_imu_lidar,
+                                                 lidar->information),
+               {{s.id, BlockRole::kPose}});
+  }
+  if (previous) {
+    add_factor(FactorKind::kImu,
+               std::make_unique<ImuFactor>(pre, config_.gravity_mps2, config_.noise),
+               {{*previous, BlockRole::kPose},
+                {*previous, BlockRole::kSpeedBias},
+                {s.id, BlockRole::kPose},
+                {s.id, BlockRole::kSpeedBias}});
   }
   while (static_cast<int>(states_.size()) > config_.size) marginalise_oldest();
+}
+
+bool SlidingWindow::add_factor(FactorKind kind, std::unique_ptr<ceres::CostFunction> cost,
+                               const std::vector<BlockRef>& refs,
+                               std::unique_ptr<ceres::LossFunction> loss) {
+  if (refs.size() != cost->parameter_block_sizes().size()) return false;
+  WindowFactor f;
+  f.kind = kind;
+  for (std::size_t k = 0; k < refs.size(); ++k) {
+    double* b = block(refs[k]);
+    const int expected = refs[k].role == BlockRole::kPose ? 7 : 9;
+    if (b == nullptr || cost->parameter_block_sizes()[k] != expected) return false;
+    f.blocks.push_back(b);
+  }
+  f.cost = std::move(cost);
+  f.loss = std::move(loss);
+  factors_.push_back(std::move(f));
+  ++counters_.factors_added[static_cast<std::size_t>(kind)];
+  return true;
 }
 
 bool SlidingWindow::solve() {
   if (states_.empty()) return true;
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.enable_fast_removal = false;
   ceres::Problem problem(po);
-  auto* manifold = const_cast<PoseManifold*>(&pose_manifold());
   for (State& s : states_) {
-    problem.AddParameterBlock(s.pose, 7, manifold);
+    problem.AddParameterBlock(s.pose, 7, &pose_manifold());
     problem.AddParameterBlock(s.speed_bias, 9);
   }
-  problem.AddResidualBlock(prior_.get(), nullptr, states_.front().pose, states_.front().speed_bias);
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    State& s = states_[i];
-    if (s.lidar) problem.AddResidualBlock(s.lidar.get(), nullptr, s.pose);
-    if (i > 0 && s.imu) {
-      State& p = states_[i - 1];
-      problem.AddResidualBlock(s.imu.get(), nullptr, p.pose, p.speed_bias, s.pose, s.speed_bias);
-    }
-  }
+  for (WindowFactor& f : factors_) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = config_.max_iterations;
@@ -162,65 +171,54 @@ bool SlidingWindow::solve() {
 
 void SlidingWindow::marginalise_oldest() {
   if (states_.size() < 2) return;
-  State& x0 = states_[0];
-  State& x1 = states_[1];
-  // Tangent coordinates: [x0 pose 6, x0 sb 9, x1 pose 6, x1 sb 9].
-  Eigen::Matrix<double, 30, 30> H = Eigen::Matrix<double, 30, 30>::Zero();
-  Eigen::Matrix<double, 30, 1> b = Eigen::Matrix<double, 30, 1>::Zero();
-  Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus0, plus1;
-  pose_manifold().PlusJacobian(x0.pose, plus0.data());
-  pose_manifold().PlusJacobian(x1.pose, plus1.data());
-
-  // Adds one residual block's JᵀJ and Jᵀr; `offsets` place each block's tangent columns.
-  const auto accumulate = [&](ceres::CostFunction& cost, std::vector<double*> params,
-                              std::vector<int> offsets) {
-    const int m = cost.num_residuals();
-    Eigen::VectorXd r(m);
-    std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J_ambient;
-    std::vector<double*> jac_ptrs;
-    for (std::size_t k = 0; k < params.size(); ++k) {
-      J_ambient.emplace_back(m, cost.parameter_block_sizes()[k]);
-    }
-    for (auto& J : J_ambient) jac_ptrs.push_back(J.data());
-    cost.Evaluate(params.data(), r.data(), jac_ptrs.data());
-    Eigen::MatrixXd J_tangent = Eigen::MatrixXd::Zero(m, 30);
-    for (std::size_t k = 0; k < params.size(); ++k) {
-      const int size = cost.parameter_block_sizes()[k];
-      if (size == 7) {
-        const auto& plus = params[k] == x0.pose ? plus0 : plus1;
-        J_tangent.middleCols(offsets[k], 6) = J_ambient[k] * plus;
-      } else {
-        J_tangent.middleCols(offsets[k], size) = J_ambient[k];
-      }
-    }
-    H += J_tangent.transpose() * J_tangent;
-    b += J_tangent.transpose() * r;
-  };
-  accumulate(*prior_, {x0.pose, x0.speed_bias}, {0, 6});
-  if (x0.lidar) accumulate(*x0.lidar, {x0.pose}, {0});
-  if (x1.imu) accumulate(*x1.imu, {x0.pose, x0.speed_bias, x1.pose, x1.speed_bias}, {0, 6, 15, 21});
-
-  // Schur complement onto x1: H* = Hrr - Hrm Hmm^-1 Hmr, b* = br - Hrm Hmm^-1 bm.
-  const Mat15 Hmm = 0.5 * (H.topLeftCorner<15, 15>() + H.topLeftCorner<15, 15>().transpose());
-  const Eigen::Matrix<double, 15, 15> Hrm = H.bottomLeftCorner<15, 15>();
-  const Eigen::LDLT<Mat15> ldlt(Hmm + 1e-9 * Mat15::Identity());
-  Mat15 Hs = H.bottomRightCorner<15, 15>() - Hrm * ldlt.solve(Hrm.transpose());
-  const Vec15 bs = b.tail<15>() - Hrm * ldlt.solve(b.head<15>());
-  Hs = 0.5 * (Hs + Hs.transpose());
-  // As a residual: H* = Jᵀ J, b* = Jᵀ r0, from the eigen-decomposition (tiny modes dropped).
-  Eigen::SelfAdjointEigenSolver<Mat15> es(Hs);
-  const Vec15 lambda = es.eigenvalues();
-  Vec15 sqrt_l = Vec15::Zero(), inv_sqrt_l = Vec15::Zero();
-  for (int i = 0; i < 15; ++i) {
-    if (lambda(i) > 1e-9) {
-      sqrt_l(i) = std::sqrt(lambda(i));
-      inv_sqrt_l(i) = 1.0 / sqrt_l(i);
+  State& x0 = states_.front();
+  const auto is_marginalised = [&](const double* b) { return b == x0.pose || b == x0.speed_bias; };
+  // The factors on x0 leave the list; every other block they touch keeps their information.
+  std::vector<WindowFactor> remaining, linearised;
+  for (WindowFactor& f : factors_) {
+    const bool touches = std::any_of(f.blocks.begin(), f.blocks.end(), is_marginalised);
+    (touches ? linearised : remaining).push_back(std::move(f));
+  }
+  // Tangent layout: x0's 15 coordinates first, then the kept blocks in order of appearance.
+  TangentLayout layout;
+  layout.add(x0.pose, 7);
+  layout.add(x0.speed_bias, 9);
+  std::vector<double*> kept;
+  std::vector<int> kept_sizes;
+  for (const WindowFactor& f : linearised) {
+    for (std::size_t k = 0; k < f.blocks.size(); ++k) {
+      if (layout.find(f.blocks[k]) != nullptr) continue;
+      layout.add(f.blocks[k], f.cost->parameter_block_sizes()[k]);
+      kept.push_back(f.blocks[k]);
+      kept_sizes.push_back(f.cost->parameter_block_sizes()[k]);
     }
   }
-  const Mat15 J = sqrt_l.asDiagonal() * es.eigenvectors().transpose();
-  const Vec15 r0 = inv_sqrt_l.asDiagonal() * es.eigenvectors().transpose() * bs;
-  prior_ = std::make_unique<StatePrior>(x1.pose, x1.speed_bias, J, r0);
-  x1.imu.reset();  // its information is in the prior now
+  const int n = layout.size, m = 15, k = n - m;
+  if (k > 0) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+    for (const WindowFactor& f : linearised) accumulate(f, layout, H, &b);
+    // Schur complement onto the kept blocks: H* = Hrr - Hrm Hmm^-1 Hmr, b* = br - Hrm Hmm^-1 bm.
+    const Eigen::MatrixXd Hmm = 0.5 * (H.topLeftCorner(m, m) + H.topLeftCorner(m, m).transpose());
+    const Eigen::MatrixXd Hrm = H.bottomLeftCorner(k, m);
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(Hmm + 1e-9 * Eigen::MatrixXd::Identity(m, m));
+    Eigen::MatrixXd Hs = H.bottomRightCorner(k, k) - Hrm * ldlt.solve(Hrm.transpose());
+    const Eigen::VectorXd bs = b.tail(k) - Hrm * ldlt.solve(b.head(m));
+    Hs = 0.5 * (Hs + Hs.transpose());
+    Eigen::MatrixXd J;
+    Eigen::VectorXd r0;
+    as_residual(Hs, bs, J, r0);
+    std::vector<PriorBlock> blocks;
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      blocks.push_back({kept_sizes[i], std::vector<double>(kept[i], kept[i] + kept_sizes[i])});
+    }
+    WindowFactor prior;
+    prior.kind = FactorKind::kPrior;
+    prior.cost = std::make_unique<MarginalPrior>(std::move(blocks), J, r0);
+    prior.blocks = kept;
+    remaining.insert(remaining.begin(), std::move(prior));
+  }
+  factors_ = std::move(remaining);
   states_.pop_front();
   ++counters_.marginalised;
 }
@@ -228,46 +226,34 @@ void SlidingWindow::marginalise_oldest() {
 Eigen::Matrix<double, 6, 6> SlidingWindow::latest_pose_covariance() const {
   // The Gauss-Newton Hessian of the whole window in tangent space, then the newest pose's block
   // of its inverse. 10 states: a 150x150 solve, well under a millisecond.
-  const int n = static_cast<int>(states_.size()) * 15;
+  TangentLayout layout;
+  for (const State& s : states_) {
+    layout.add(s.pose, 7);
+    layout.add(s.speed_bias, 9);
+  }
+  const int n = layout.size;
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
-  std::vector<Eigen::Matrix<double, 7, 6, Eigen::RowMajor>> plus(states_.size());
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    pose_manifold().PlusJacobian(states_[i].pose, plus[i].data());
-  }
-  const auto add = [&](ceres::CostFunction& cost, const std::vector<std::size_t>& state_of_block,
-                       std::vector<const double*> params) {
-    const int m = cost.num_residuals();
-    Eigen::VectorXd r(m);
-    std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J_ambient;
-    std::vector<double*> jac_ptrs;
-    for (std::size_t k = 0; k < params.size(); ++k) {
-      J_ambient.emplace_back(m, cost.parameter_block_sizes()[k]);
-    }
-    for (auto& Jk : J_ambient) jac_ptrs.push_back(Jk.data());
-    cost.Evaluate(params.data(), r.data(), jac_ptrs.data());
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
-    for (std::size_t k = 0; k < params.size(); ++k) {
-      const auto base = static_cast<Eigen::Index>(state_of_block[k] * 15);
-      if (cost.parameter_block_sizes()[k] == 7) {
-        J.middleCols(base, 6) = J_ambient[k] * plus[state_of_block[k]];
-      } else {
-        J.middleCols(base + 6, 9) = J_ambient[k];
-      }
-    }
-    H += J.transpose() * J;
-  };
-  add(*prior_, {0, 0}, {states_[0].pose, states_[0].speed_bias});
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    const State& s = states_[i];
-    if (s.lidar) add(*s.lidar, {i}, {s.pose});
-    if (i > 0 && s.imu) {
-      const State& p = states_[i - 1];
-      add(*s.imu, {i - 1, i - 1, i, i}, {p.pose, p.speed_bias, s.pose, s.speed_bias});
-    }
-  }
+  for (const WindowFactor& f : factors_) accumulate(f, layout, H, nullptr);
   const Eigen::MatrixXd cov =
       (H + 1e-9 * Eigen::MatrixXd::Identity(n, n)).ldlt().solve(Eigen::MatrixXd::Identity(n, n));
-  return cov.block<6, 6>(n - 15, n - 15);
+  const int newest = layout.find(states_.back().pose)->offset;
+  return cov.block<6, 6>(newest, newest);
+}
+
+std::array<std::size_t, kFactorKinds> SlidingWindow::factor_counts() const {
+  std::array<std::size_t, kFactorKinds> counts{};
+  for (const WindowFactor& f : factors_) ++counts[static_cast<std::size_t>(f.kind)];
+  return counts;
+}
+
+void SlidingWindow::residual_norms(FactorKind kind, std::vector<double>& out) const {
+  out.clear();
+  for (const WindowFactor& f : factors_) {
+    if (f.kind != kind) continue;
+    Eigen::VectorXd r(f.cost->num_residuals());
+    std::vector<const double*> params(f.blocks.begin(), f.blocks.end());
+    if (f.cost->Evaluate(params.data(), r.data(), nullptr)) out.push_back(r.norm());
+  }
 }
 
 }  // namespace posed::estimator

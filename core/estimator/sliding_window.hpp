@@ -1,24 +1,28 @@
 #pragma once
-// The fixed-lag window of the lidar-inertial back end (seed 001's Ceres sliding window; VINS-Mono,
-// LIO-SAM): the last `size` states at scan times, tied by preintegrated IMU factors (with the bias
-// random walk) and anchored by scan-to-map lidar pose factors. When the window is full the oldest
-// state is marginalised: the factors that touch it are linearised and its information is kept as
-// a Gaussian prior on its neighbour (the Schur complement), so what the dropped states taught
-// about velocity and biases is not lost. That is how the IMU biases converge over many windows.
+// The fixed-lag window of the back end (seed 001's Ceres sliding window; VINS-Mono, LIO-SAM): the
+// last `size` states at scan times, and one list of factors over their parameter blocks
+// (window_factor.hpp): preintegrated IMU between consecutive states (with the bias random walk),
+// scan-to-map lidar poses, camera relative motions, and a prior. Solve, marginalisation and
+// covariance each iterate over that list and know no factor kind.
 //
-// Deterministic: single-threaded Ceres with fixed options and problem order.
+// When the window is full the oldest state is marginalised: every factor that touches its blocks
+// is linearised at the current estimate, the state's tangent coordinates are eliminated from those
+// normal equations (Schur complement), and what remains becomes one Gaussian prior on every block
+// those factors also touched (MarginalPrior). So what the dropped states taught about velocity and
+// biases is not lost; that is how the IMU biases converge over many windows.
+//
+// Deterministic: single-threaded Ceres with fixed options, and factors in insertion order.
 
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <optional>
 #include <vector>
 
+#include "core/estimator/window_factor.hpp"
 #include "core/imu/preintegration.hpp"
-
-namespace ceres {
-class CostFunction;
-}
 
 namespace posed::estimator {
 
@@ -42,6 +46,8 @@ struct SlidingWindowCounters {
   std::uint64_t failed_solves = 0;
   std::uint64_t marginalised = 0;
   std::uint64_t iterations = 0;  ///< summed over solves
+  /// factors added, by FactorKind [1]
+  std::array<std::uint64_t, kFactorKinds> factors_added{};
 };
 
 class SlidingWindow {
@@ -58,6 +64,11 @@ class SlidingWindow {
   /// with an optional lidar pose. Marginalises the oldest when the window is over its size.
   void add(const imu::ImuState& guess, const imu::Preintegration& pre,
            const std::optional<LidarPose>& lidar);
+  /// Adds a factor on the blocks `refs` (in the cost function's order). False, and nothing
+  /// added, when a referenced state has left the window or the sizes do not match.
+  bool add_factor(FactorKind kind, std::unique_ptr<ceres::CostFunction> cost,
+                  const std::vector<BlockRef>& refs,
+                  std::unique_ptr<ceres::LossFunction> loss = nullptr);
   /// Optimises the window; false when Ceres reported a failure (the states keep their values).
   bool solve();
 
@@ -65,27 +76,35 @@ class SlidingWindow {
   std::size_t size() const { return states_.size(); }
   imu::ImuState state(std::size_t i) const;
   imu::ImuState latest() const { return state(states_.size() - 1); }
+  /// The id of state i: counts states since construction, stable while the state is in the
+  /// window, never reused.
+  std::uint64_t id(std::size_t i) const { return states_.at(i).id; }
+  std::uint64_t latest_id() const { return states_.back().id; }
+  /// The index of the state with `id`, if it is still in the window.
+  std::optional<std::size_t> index_of(std::uint64_t id) const;
   /// Marginal covariance of the newest state's pose, tangent [dp (map), dtheta (body)]
   /// [m², rad²], from the window's Gauss-Newton Hessian at the current estimate.
   Eigen::Matrix<double, 6, 6> latest_pose_covariance() const;
+  /// The factors now in the window, by kind [1].
+  std::array<std::size_t, kFactorKinds> factor_counts() const;
+  /// Whitened residual norm |r| of every factor of `kind` at the current estimate, in list order.
+  void residual_norms(FactorKind kind, std::vector<double>& out) const;
   const SlidingWindowCounters& counters() const { return counters_; }
 
  private:
   struct State {
+    std::uint64_t id = 0;
     HostTime stamp;
     double pose[7];
     double speed_bias[9];
-    /// the lidar pose factor on this state, if any
-    std::unique_ptr<ceres::CostFunction> lidar;
-    /// the IMU factor from the previous state to this one (null for the oldest)
-    std::unique_ptr<ceres::CostFunction> imu;
   };
+  double* block(const BlockRef& ref);
   void marginalise_oldest();
 
   SlidingWindowConfig config_;
-  std::deque<State> states_;
-  /// prior on states_.front() (pose, speed_bias)
-  std::unique_ptr<ceres::CostFunction> prior_;
+  std::deque<State> states_;  // references stay valid as states come and go at the ends
+  std::vector<WindowFactor> factors_;
+  std::uint64_t next_id_ = 1;
   SlidingWindowCounters counters_;
 };
 

@@ -100,5 +100,57 @@ TEST(Factors, LidarPoseFactorJacobiansMatchNumericDifferentiation) {
   expect_jacobians_match(results, 1e-6);
 }
 
+TEST(Factors, RelativePoseFactorJacobiansMatchNumericDifferentiation) {
+  Eigen::Isometry3d T_meas = Eigen::Isometry3d::Identity();
+  T_meas.linear() = so3::exp(Eigen::Vector3d(0.02, -0.03, 0.1));
+  T_meas.translation() = Eigen::Vector3d(0.12, -0.02, 0.01);
+  Eigen::Matrix<double, 6, 6> info = Eigen::Matrix<double, 6, 6>::Identity() * 400;
+  info(1, 3) = info(3, 1) = 50;  // a camera's rotation and translation are correlated
+  const RelativePoseFactor factor(T_meas, info);
+  imu::ImuState i, j;
+  i.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.12, -0.18, 0.45)));
+  i.p_map_imu_m = Eigen::Vector3d(3.1, -2.2, 0.4);
+  j.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.1, -0.15, 0.6)));
+  j.p_map_imu_m = Eigen::Vector3d(3.3, -2.1, 0.45);
+  double pose_i[7], pose_j[7], sb[9];
+  state_arrays(i, pose_i, sb);
+  state_arrays(j, pose_j, sb);
+  const double* params[] = {pose_i, pose_j};
+  PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, &pose_manifold};
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, 1e-6, &results);
+  expect_jacobians_match(results, 1e-6);
+}
+
+TEST(Factors, RelativePoseFactorIsZeroAtTheMeasuredMotion) {
+  Eigen::Isometry3d T_i = Eigen::Isometry3d::Identity(), T_ij = Eigen::Isometry3d::Identity();
+  T_i.linear() = so3::exp(Eigen::Vector3d(0.3, -0.1, 1.2));
+  T_i.translation() = Eigen::Vector3d(5, 1, -2);
+  T_ij.linear() = so3::exp(Eigen::Vector3d(0.01, 0.02, 0.05));
+  T_ij.translation() = Eigen::Vector3d(0.1, 0.01, 0.0);
+  const Eigen::Isometry3d T_j = T_i * T_ij;
+  const RelativePoseFactor factor(T_ij, Eigen::Matrix<double, 6, 6>::Identity() * 1e4);
+  imu::ImuState i, j;
+  i.q_map_imu = Eigen::Quaterniond(T_i.linear());
+  i.p_map_imu_m = T_i.translation();
+  j.q_map_imu = Eigen::Quaterniond(T_j.linear());
+  j.p_map_imu_m = T_j.translation();
+  double pose_i[7], pose_j[7], sb[9], r[6];
+  state_arrays(i, pose_i, sb);
+  state_arrays(j, pose_j, sb);
+  const double* params[] = {pose_i, pose_j};
+  ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  EXPECT_LT(Eigen::Map<Vec6>(r).norm(), 1e-9);
+  // 1 cm off along x in frame i: a residual of 1 cm times the square-root information.
+  j.p_map_imu_m += T_i.linear() * Eigen::Vector3d(0.01, 0, 0);
+  state_arrays(j, pose_j, sb);
+  ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
+  EXPECT_NEAR(Eigen::Map<Vec6>(r).norm(), 0.01 * 100, 1e-3);
+}
+
 }  // namespace
 }  // namespace posed::estimator
