@@ -13,6 +13,7 @@
 
 #include "daemon/build_info.hpp"
 #include "daemon/dds/publisher.hpp"
+#include "daemon/estimator_summary.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
 #include "daemon/pipeline/camera_calibration.hpp"
@@ -443,8 +444,9 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     const double frames = static_cast<double>(std::max<std::uint64_t>(c.frames, 1));
     std::printf(
         "  camera front end    %s: %llu frames (%llu unusable, %llu without IMU), %.0f "
-        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features; mean "
-        "confidence visible %.2f, thermal %.2f, fused %.2f\n",
+        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features, %llu tracks "
+        "dropped as fixed to the camera; mean confidence visible %.2f, thermal %.2f, fused "
+        "%.2f\n",
         std::string(c.mode).c_str(), static_cast<unsigned long long>(c.frames),
         static_cast<unsigned long long>(c.frames_unusable),
         static_cast<unsigned long long>(c.frames_without_imu),
@@ -452,8 +454,10 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
         c.features_total > 0
             ? 100.0 * static_cast<double>(c.depth_total) / static_cast<double>(c.features_total)
             : 0.0,
-        c.mean_confidence[0], c.mean_confidence[1], c.mean_confidence[2]);
+        static_cast<unsigned long long>(c.static_dropped_total), c.mean_confidence[0],
+        c.mean_confidence[1], c.mean_confidence[2]);
   }
+  print_visual_summary(st.estimator);
   if (!publisher)
     std::printf("  published           nothing (offline run, no DDS)\n");
   else

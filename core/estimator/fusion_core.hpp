@@ -11,6 +11,7 @@
 #include <array>
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -42,9 +43,11 @@ struct CameraFigures {
   std::uint64_t extracted_total = 0;     ///< new features detected, summed [1]
   std::uint64_t features_total = 0;      ///< features output, summed [1]
   std::uint64_t depth_total = 0;         ///< of those, with lidar depth, summed [1]
-  int features = 0;                      ///< in the last frame [1]
-  int depth_associated = 0;              ///< in the last frame [1]
-  int lidar_points = 0;                  ///< in the last frame's depth tree [1]
+  /// tracks dropped for staying put while the camera turned (fixed to the camera), summed [1]
+  std::uint64_t static_dropped_total = 0;
+  int features = 0;          ///< in the last frame [1]
+  int depth_associated = 0;  ///< in the last frame [1]
+  int lidar_points = 0;      ///< in the last frame's depth tree [1]
   /// visible, thermal, fused (by vision::FrontendMode order) in the last frame
   std::array<StreamQualityFigures, 3> quality{};
   /// means of confidence over the frames where the stream was assessed (visible, thermal, fused)
@@ -59,6 +62,47 @@ struct CameraFigures {
   }
 };
 
+/// One camera stream in the back end (visible, thermal, fused: vision::FrontendMode order): how
+/// its frame-to-frame motions entered the window as between factors (seed 002).
+struct VisualStreamFigures {
+  bool configured = false;      ///< this stream feeds the estimate when its images are good enough
+  bool active = false;          ///< its quality gate is open now
+  double omega = 0;             ///< covariance scale of its last frame (1 without weighting) [-]
+  double confidence = 0;        ///< image-quality confidence of its last frame [0..1]
+  std::uint64_t frames = 0;     ///< frames it received [1]
+  std::uint64_t factors = 0;    ///< between factors it added to the window [1]
+  std::uint64_t gated_out = 0;  ///< state intervals skipped while its gate was closed [1]
+  std::uint64_t no_frames = 0;  ///< intervals without a frame near both states [1]
+  std::uint64_t failed = 0;     ///< intervals whose motion could not be estimated [1]
+  std::uint64_t implausible = 0;   ///< motions refused: too far from the IMU's prediction [1]
+  std::uint64_t left = 0;          ///< times the gate closed (image quality fell) [1]
+  std::uint64_t rejoined = 0;      ///< times it opened again [1]
+  int inliers = 0;                 ///< observations kept in its last motion [1]
+  double reprojection_rms_px = 0;  ///< RMS reprojection error of its last motion [px]
+  /// median whitened residual |r| of its factors in the window after the last solve [sigma]
+  double residual_median = 0;
+};
+
+/// Seed 001's adaptive pose selection: which odometry gave each state its initial value.
+struct PoseSelectionFigures {
+  std::uint64_t lidar_visual_inertial = 0;  ///< the fused (LCI) position [1]
+  std::uint64_t lidar_inertial = 0;         ///< the scan match (LIO) [1]
+  std::uint64_t visual_inertial = 0;        ///< the camera motion on the IMU (CIO) [1]
+  std::uint64_t imu_only = 0;   ///< neither lidar nor camera to choose from: the IMU prediction [1]
+  double last_threshold_m = 0;  ///< S of the last decision [m]
+};
+
+/// Which measurements entered the estimate at the last state (bits of Modality).
+enum Modality : std::uint8_t {
+  kModalityImu = 1,
+  kModalityLidar = 2,
+  kModalityVisible = 4,
+  kModalityThermal = 8,
+  kModalityFused = 16,
+};
+/// e.g. "imu+lidar+visible"
+std::string modality_names(std::uint8_t modalities);
+
 struct FusionFigures {
   std::uint64_t scans_used = 0;         ///< scans whose match entered the estimate [1]
   std::uint64_t scans_rejected = 0;     ///< matches refused (too few points, implausible jump) [1]
@@ -71,6 +115,11 @@ struct FusionFigures {
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]
   /// the camera front end's figures (mode empty without one)
   CameraFigures camera;
+  /// the camera streams in the back end (visible, thermal, fused)
+  std::array<VisualStreamFigures, 3> visual{};
+  PoseSelectionFigures selection;
+  /// what entered the estimate at the last state (Modality bits)
+  std::uint8_t modalities = 0;
 };
 
 /// The map an estimator built over a run, for export at its end (posed --save-map).

@@ -1,8 +1,13 @@
 #include "core/estimator/lio_estimator.hpp"
 
+#include <ceres/loss_function.h>
+
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
+#include "core/estimator/factors.hpp"
 #include "core/math/so3.hpp"
 
 namespace posed::estimator {
@@ -21,6 +26,13 @@ Eigen::Isometry3d pose_of(const imu::ImuState& s) {
   T.linear() = s.q_map_imu.toRotationMatrix();
   T.translation() = s.p_map_imu_m;
   return T;
+}
+
+/// The covariance of an information matrix that may be singular (a direction nothing measured
+/// gets a variance of 1e9).
+Eigen::Matrix<double, 6, 6> covariance_of(const Eigen::Matrix<double, 6, 6>& information) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  return (information + 1e-9 * Mat6::Identity()).ldlt().solve(Mat6::Identity());
 }
 
 }  // namespace
@@ -361,10 +373,7 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     // The IMU contradicts the lidar: its preintegration cannot join the window.
     reinitialise(imu_state_at(match.T_map_lidar, t), *lidar_velocity);
   } else {
-    std::optional<LidarPose> lidar_factor;
-    if (match.ok) lidar_factor = LidarPose{match.T_map_lidar_measured, match.information};
-    window_.add(predicted, integrated.pre, lidar_factor);
-    window_.solve();
+    add_to_window(predicted, integrated.pre, match);
   }
   imu::ImuState estimate = window_.latest();
   if (!imu_suspect) {
@@ -406,6 +415,107 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
                             anchor_cov_);
   s.sequence = ++sequence_;
   states.push_back(s);
+}
+
+void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Preintegration& pre,
+                                 const lidar::ScanMatchResult& match) {
+  std::uint8_t modalities = kModalityImu;
+  std::optional<LidarPose> lidar_factor;
+  if (match.ok) {
+    lidar_factor = LidarPose{match.T_map_lidar_measured, match.information};
+    modalities |= kModalityLidar;
+  }
+  motions_.clear();
+  if (aiding_ != nullptr) aiding_->relative_motions(window_, predicted, motions_);
+  const imu::ImuState initial = initial_value(predicted, pre, match);
+  const std::uint64_t previous = window_.latest_id();
+  window_.add(initial, pre, lidar_factor);
+  for (const RelativeMotion& m : motions_) {
+    std::unique_ptr<ceres::LossFunction> loss;
+    if (m.huber_sigma > 0) loss = std::make_unique<ceres::HuberLoss>(m.huber_sigma);
+    const bool added = window_.add_factor(
+        m.kind, std::make_unique<RelativePoseFactor>(m.T_i_j, m.information),
+        {{previous, BlockRole::kPose}, {window_.latest_id(), BlockRole::kPose}}, std::move(loss));
+    if (!added) continue;
+    modalities |= m.kind == FactorKind::kVisible   ? kModalityVisible
+                  : m.kind == FactorKind::kThermal ? kModalityThermal
+                                                   : kModalityFused;
+  }
+  window_.solve();
+  if (aiding_ != nullptr) aiding_->after_solve(window_);
+  figures_.modalities = modalities;
+}
+
+imu::ImuState LioEstimator::initial_value(const imu::ImuState& predicted,
+                                          const imu::Preintegration& pre,
+                                          const lidar::ScanMatchResult& match) {
+  if (!config_.pose_selection) return predicted;
+  const imu::ImuState previous = window_.latest();
+  const Eigen::Matrix3d R_prev = previous.q_map_imu.toRotationMatrix();
+  // Each odometry's position with its information in the map frame (translation blocks of the
+  // right-perturbation informations, rotated into the map).
+  const auto in_map = [](const Eigen::Matrix3d& R, const Eigen::Matrix3d& information_body) {
+    return Eigen::Matrix3d(R * information_body * R.transpose());
+  };
+  std::vector<WeightedPosition> cameras;
+  std::optional<Eigen::Matrix3d> R_cio;
+  for (const RelativeMotion& m : motions_) {
+    const Eigen::Isometry3d T = pose_of(previous) * m.T_i_j;
+    const Eigen::Matrix3d cov_t = covariance_of(m.information).bottomRightCorner<3, 3>();
+    cameras.push_back({T.translation(), in_map(T.linear(), cov_t.inverse())});
+    if (!R_cio) R_cio = T.linear();
+  }
+  std::optional<Eigen::Isometry3d> T_lio;
+  WeightedPosition lio;
+  if (match.ok) {
+    T_lio = match.T_map_lidar * config_.T_imu_lidar.inverse();
+    lio.p = T_lio->translation();
+    const Eigen::Matrix3d cov_t = covariance_of(match.information).bottomRightCorner<3, 3>();
+    lio.information = in_map(match.T_map_lidar.linear(), cov_t.inverse());
+  }
+  PoseSelectionInput in;
+  in.threshold_m = 0.5 * (previous.v_map_mps.norm() + predicted.v_map_mps.norm()) * pre.dt_s();
+  in.imu = predicted.p_map_imu_m - previous.p_map_imu_m;
+  std::optional<Eigen::Vector3d> p_cio, p_lci;
+  if (T_lio) in.lio = lio.p - previous.p_map_imu_m;
+  if (!cameras.empty()) {
+    p_cio = combine(cameras.data(), cameras.size());
+    if (p_cio) in.cio = *p_cio - previous.p_map_imu_m;
+  }
+  if (T_lio && p_cio) {
+    std::vector<WeightedPosition> all = cameras;
+    all.push_back(lio);
+    // The IMU's prediction, as certain as the preintegration's position block says.
+    const Eigen::Matrix3d cov_imu =
+        pre.covariance().bottomRightCorner<3, 3>() + 1e-6 * Eigen::Matrix3d::Identity();
+    all.push_back({predicted.p_map_imu_m, in_map(R_prev, cov_imu.inverse())});
+    p_lci = combine(all.data(), all.size());
+    if (p_lci) in.lci = *p_lci - previous.p_map_imu_m;
+  }
+  PoseSelectionFigures& f = figures_.selection;
+  f.last_threshold_m = in.threshold_m;
+  imu::ImuState initial = predicted;
+  switch (select_pose(in)) {
+    case PoseChoice::kImu:
+      ++f.imu_only;
+      break;
+    case PoseChoice::kLidarInertial:
+      ++f.lidar_inertial;
+      initial.p_map_imu_m = T_lio->translation();
+      initial.q_map_imu = Eigen::Quaterniond(T_lio->linear()).normalized();
+      break;
+    case PoseChoice::kVisualInertial:
+      ++f.visual_inertial;
+      initial.p_map_imu_m = *p_cio;
+      initial.q_map_imu = Eigen::Quaterniond(*R_cio).normalized();
+      break;
+    case PoseChoice::kLidarVisualInertial:
+      ++f.lidar_visual_inertial;
+      initial.p_map_imu_m = *p_lci;
+      if (T_lio) initial.q_map_imu = Eigen::Quaterniond(T_lio->linear()).normalized();
+      break;
+  }
+  return initial;
 }
 
 bool LioEstimator::latest_matched_scan(MatchedScan& out) const {

@@ -24,7 +24,9 @@
 #include <vector>
 
 #include "core/estimator/fusion_core.hpp"
+#include "core/estimator/pose_selection.hpp"
 #include "core/estimator/sliding_window.hpp"
+#include "core/estimator/window_aiding.hpp"
 #include "core/imu/moving_alignment.hpp"
 #include "core/imu/preintegration.hpp"
 #include "core/imu/static_alignment.hpp"
@@ -52,6 +54,9 @@ struct LioConfig {
   /// a scan match this far from the IMU prediction is refused rather than believed [m]
   double max_match_jump_m = 1.0;
   double max_match_jump_rad = 0.2;  ///< [rad]
+  /// seed 001's adaptive pose selection of each state's initial value (pose_selection.hpp); off:
+  /// the IMU prediction
+  bool pose_selection = true;
   /// keep every keyframe's points in a whole-run map for export_map(); off on a robot that
   /// never exports, since it grows with the area explored
   bool keep_map = false;
@@ -83,6 +88,8 @@ class LioEstimator final : public FusionCore {
   explicit LioEstimator(const LioConfig& config);
   /// Optional: called around every step of every scan (null: none).
   void set_probe(LioStepProbe* probe) { probe_ = probe; }
+  /// Optional: further relative-motion factors for every new state (the cameras; null: none).
+  void set_aiding(WindowAiding* aiding) { aiding_ = aiding; }
 
   void add_imu(const ImuSample& sample, std::vector<NavState>& states) override;
   void add_scan(LidarScan scan, std::vector<NavState>& states) override;
@@ -105,6 +112,13 @@ class LioEstimator final : public FusionCore {
   };
   void release_scans(std::vector<NavState>& states);
   void process_scan(const Bundle<LidarScan>& bundle, std::vector<NavState>& states);
+  /// The new state at the scan's end joins the window with its IMU, lidar and aiding factors,
+  /// from the initial value the pose selection chose; the window is solved.
+  void add_to_window(const imu::ImuState& predicted, const imu::Preintegration& pre,
+                     const lidar::ScanMatchResult& match);
+  /// Seed 001's choice among the IMU prediction, the scan match and the aiding's motions.
+  imu::ImuState initial_value(const imu::ImuState& predicted, const imu::Preintegration& pre,
+                              const lidar::ScanMatchResult& match);
   /// Preintegrates the held IMU from `from` (its stamp and biases) to `t`, filling the deskew
   /// motion of the lidar over [from.stamp, t] when `motion` is given.
   Integrated integrate(const imu::ImuState& from, HostTime t, lidar::ScanMotion* motion);
@@ -155,6 +169,8 @@ class LioEstimator final : public FusionCore {
   FusionFigures figures_;
   std::uint64_t sequence_ = 0;
   LioStepProbe* probe_ = nullptr;
+  WindowAiding* aiding_ = nullptr;
+  std::vector<RelativeMotion> motions_;  // this scan's, from the aiding
   void begin(LioStep s) {
     if (probe_ != nullptr) probe_->begin(s);
   }

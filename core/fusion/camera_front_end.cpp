@@ -1,6 +1,7 @@
 #include "core/fusion/camera_front_end.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/fusion/gyro_rotation.hpp"
 
@@ -39,6 +40,9 @@ CameraFrontEnd::CameraFrontEnd(const CameraFrontEndConfig& config)
     c.mode = mode;
     Run run;
     run.frontend = std::make_unique<vision::VisualFrontend>(c);
+    StaticTrackConfig st = config.static_tracks;
+    st.focal_px = 0.5 * (c.visible_camera.fx + c.visible_camera.fy);
+    run.static_tracks = std::make_unique<StaticTrackFilter>(st);
     run.figures.mode = vision::to_string(mode);
     runs_.push_back(std::move(run));
   }
@@ -118,9 +122,21 @@ void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps)
       depth_.points_in_camera(e.stamp, T_map_base * config_.T_imu_cam, p_cam_m_);
     }
   }
-  input.p_cam_m = p_cam_m_;
+  // Thermal mode tracks the thermal image registered at infinity: a camera at the thermal
+  // camera's origin with the visible camera's axes, so its features' depth comes from the points
+  // seen from there (17 cm to the side on the M2DGR rig: 3 deg of parallax at 3 m).
+  p_thermal_origin_m_.clear();
+  const Eigen::Vector3f t_cam_thermal = config_.frontend.T_cam_thermal.translation().cast<float>();
+  for (const Run& run : runs_) {
+    if (run.frontend->config().mode != vision::FrontendMode::kThermal) continue;
+    for (const Eigen::Vector3f& p : p_cam_m_) p_thermal_origin_m_.push_back(p - t_cam_thermal);
+    break;
+  }
   for (Run& run : runs_) {
     const vision::FrontendMode mode = run.frontend->config().mode;
+    input.p_cam_m = mode == vision::FrontendMode::kThermal
+                        ? std::span<const Eigen::Vector3f>(p_thermal_origin_m_)
+                        : std::span<const Eigen::Vector3f>(p_cam_m_);
     const bool usable = (mode != vision::FrontendMode::kVisible || e.visible) &&
                         (mode != vision::FrontendMode::kThermal || e.thermal) &&
                         (mode != vision::FrontendMode::kFused || (e.visible && e.thermal));
@@ -129,11 +145,34 @@ void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps)
       continue;
     }
     const vision::FrontendStatus status = run.frontend->process(input, run.frame);
-    account(run, status);
-    if (status == vision::FrontendStatus::kOk && observer_ != nullptr) {
-      observer_->on_frame(run.frame, *run.frontend);
+    if (status == vision::FrontendStatus::kOk) {
+      if (config_.drop_static_tracks) {
+        drop_static_tracks(run);
+      } else {
+        for (vision::FrontendFeature& f : run.frame.features) f.verified = true;
+      }
     }
+    account(run, status);
+    if (status != vision::FrontendStatus::kOk) continue;
+    if (back_end_ != nullptr) back_end_->on_frame(run.frame, *run.frontend);
+    if (observer_ != nullptr) observer_->on_frame(run.frame, *run.frontend);
   }
+}
+
+void CameraFrontEnd::drop_static_tracks(Run& run) {
+  vision::FrontendFrame& frame = run.frame;
+  fixed_ids_.clear();
+  run.static_tracks->update(frame.features, fixed_ids_);
+  if (fixed_ids_.empty()) return;
+  run.frontend->drop_tracks(fixed_ids_);
+  std::erase_if(frame.features, [&](const vision::FrontendFeature& f) {
+    return std::binary_search(fixed_ids_.begin(), fixed_ids_.end(), f.id);
+  });
+  run.figures.static_dropped_total += fixed_ids_.size();
+  frame.counts.features = static_cast<int>(frame.features.size());
+  frame.counts.depth_associated = static_cast<int>(
+      std::count_if(frame.features.begin(), frame.features.end(),
+                    [](const vision::FrontendFeature& f) { return std::isfinite(f.depth_m); }));
 }
 
 void CameraFrontEnd::account(Run& run, vision::FrontendStatus status) {

@@ -24,6 +24,7 @@
 
 #include "core/estimator/fusion_core.hpp"
 #include "core/fusion/depth_cloud.hpp"
+#include "core/fusion/static_track_filter.hpp"
 #include "core/measurements.hpp"
 #include "core/sync/imu_buffer.hpp"
 #include "core/sync/pose_interpolation.hpp"
@@ -51,6 +52,10 @@ struct CameraFrontEndConfig {
   /// stage hands measurements over in stamp order (replays); live, the cameras' latency.
   Duration arrival_lag = Duration::from_ns(0);
   DepthCloudConfig depth;
+  /// tracks fixed to the camera are dropped and the others verified (StaticTrackFilter); false:
+  /// every track counts as verified
+  bool drop_static_tracks = true;
+  StaticTrackConfig static_tracks;  ///< focal_px is set from the visible camera
 };
 
 /// Sees every frame a front end processed, with the front end (its images), e.g. to annotate.
@@ -78,6 +83,8 @@ class CameraFrontEnd {
   void process(const Eigen::Vector3d& gyro_bias_radps);
 
   void set_observer(FrontendObserver* observer) { observer_ = observer; }
+  /// The back end that turns the frames into factors (CameraFactors); called before the observer.
+  void set_back_end(FrontendObserver* back_end) { back_end_ = back_end; }
   /// The primary front end's figures.
   const CameraFigures& figures() const { return runs_.front().figures; }
   /// The comparison front ends' figures, in compare_modes order.
@@ -95,7 +102,11 @@ class CameraFrontEnd {
     std::unique_ptr<vision::VisualFrontend> frontend;
     vision::FrontendFrame frame;
     CameraFigures figures;
+    std::unique_ptr<StaticTrackFilter> static_tracks;
   };
+  /// Verifies the run's tracks that move with the world and drops those fixed to the camera
+  /// (StaticTrackFilter).
+  void drop_static_tracks(Run& run);
   void run_event(Event& event, const Eigen::Vector3d& gyro_bias_radps);
   void account(Run& run, vision::FrontendStatus status);
 
@@ -107,9 +118,13 @@ class CameraFrontEnd {
   std::deque<Event> ready_;
   std::vector<Run> runs_;  // the primary first, then compare_modes
   FrontendObserver* observer_ = nullptr;
+  FrontendObserver* back_end_ = nullptr;
   std::uint64_t last_scan_index_ = 0;
   std::vector<ImuSample> scratch_;
   std::vector<Eigen::Vector3f> p_cam_m_;
+  /// the same points from the thermal camera's origin (thermal mode's camera, see run_event)
+  std::vector<Eigen::Vector3f> p_thermal_origin_m_;
+  std::vector<std::uint64_t> fixed_ids_;
 };
 
 }  // namespace posed::fusion

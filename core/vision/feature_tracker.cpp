@@ -36,6 +36,11 @@ void FeatureTracker::reset() {
   previous_pyramid_.clear();
 }
 
+void FeatureTracker::drop(const std::vector<std::uint64_t>& ids) {
+  std::erase_if(tracks_,
+                [&](const Track& t) { return std::binary_search(ids.begin(), ids.end(), t.id); });
+}
+
 Eigen::Vector2d FeatureTracker::normalise(const cv::Point2f& pixel) const {
   return undistorter_.normalised(Eigen::Vector2d(pixel.x, pixel.y));
 }
@@ -129,6 +134,18 @@ TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask
   return stats;
 }
 
+void FeatureTracker::mask_weak_corners(const cv::Mat& image) {
+  cv::cornerMinEigenVal(image, corner_score_, config_.corner_block_size, 3);
+  scores_.assign(corner_score_.begin<float>(), corner_score_.end<float>());
+  if (scores_.empty()) return;
+  const auto mid = scores_.begin() + static_cast<std::ptrdiff_t>(scores_.size() / 2);
+  std::nth_element(scores_.begin(), mid, scores_.end());
+  const double threshold = config_.corner_noise_factor * static_cast<double>(*mid);
+  cv::Mat strong;
+  cv::compare(corner_score_, threshold, strong, cv::CMP_GT);
+  cv::bitwise_and(mask_, strong, mask_);
+}
+
 void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, TrackStats& stats) {
   // Corners are looked for on pyramid level `detect_level`; the mask lives at that resolution
   // too (its discs then cost a quarter per level). pyramid_ holds image and derivatives per
@@ -178,6 +195,7 @@ void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, Tra
 
   const int wanted = config_.max_features - static_cast<int>(tracks_.size());
   if (wanted <= 0) return;
+  if (config_.corner_noise_factor > 0) mask_weak_corners(image);
   cv::goodFeaturesToTrack(image, corners_, wanted, config_.corner_quality, min_distance, mask_,
                           config_.corner_block_size);
   const float border = static_cast<float>(config_.border_px);

@@ -40,6 +40,13 @@ struct TrackerConfig {
   /// around the corner wherever within its pixel it was placed [1]
   int detect_level = 1;
   int border_px = 2;  ///< features closer to the edge are dropped [px]
+  /// a new corner's Shi-Tomasi score must exceed this multiple of the image's median score
+  /// (0: off). On a plain, noisy surface (a corridor wall lit by the headlight, a thermal
+  /// image of uniform walls with fixed-pattern noise) every "corner" is noise over shading that
+  /// does not move in the image, and KLT follows it as a feature that never moves: a camera
+  /// that seems to stand still while it drives. The median score is that noise floor wherever
+  /// most of the image is untextured, and below any real corner elsewhere [-]
+  double corner_noise_factor = 0;
 };
 
 /// One tracked point.
@@ -80,10 +87,14 @@ class FeatureTracker {
   const std::vector<Track>& tracks() const { return tracks_; }
   /// Forgets every track (ids continue).
   void reset();
+  /// Forgets the tracks with these ids (sorted ascending).
+  void drop(const std::vector<std::uint64_t>& ids);
 
  private:
   Eigen::Vector2d normalise(const cv::Point2f& pixel) const;
   void detect(const cv::Mat& grey, const cv::Mat& detect_mask, TrackStats& stats);
+  /// Clears mask_ where the corner score is within corner_noise_factor of the median.
+  void mask_weak_corners(const cv::Mat& image);
 
   TrackerConfig config_;
   PinholeCamera camera_;
@@ -97,6 +108,8 @@ class FeatureTracker {
   std::vector<float> error_;
   std::vector<std::size_t> order_;
   cv::Mat mask_;  // at the detection level's resolution
+  cv::Mat corner_score_;
+  std::vector<float> scores_;
 };
 
 }  // namespace posed::vision

@@ -45,6 +45,9 @@ struct FrontendFeature {
   /// change of `normalised` since the previous frame over the stamp difference [1/s]; zero for
   /// a new feature
   Eigen::Vector2d velocity_per_s = Eigen::Vector2d::Zero();
+  /// its image has moved as a point of the world would (fusion::StaticTrackFilter); until then
+  /// it may be fixed to the camera and does not enter the estimate
+  bool verified = false;
 };
 
 /// Per-stream image quality (seed 002). `valid` is false for a stream this mode does not build.

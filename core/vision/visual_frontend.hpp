@@ -87,6 +87,10 @@ class VisualFrontend {
   /// than kOk nothing is tracked and the trackers keep their state for the next frame.
   FrontendStatus process(const FrontendInput& input, FrontendFrame& out);
 
+  /// Stops tracking the features with these ids (sorted ascending): the caller found them to be
+  /// no part of the world (fusion::StaticTrackFilter).
+  void drop_tracks(const std::vector<std::uint64_t>& ids) { tracker_.drop(ids); }
+
   /// The grey images of the last frame (visible size), for inspection and annotation; empty for
   /// streams the mode does not build.
   const cv::Mat& visible_grey() const { return visible_grey_; }

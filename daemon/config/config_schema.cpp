@@ -237,6 +237,10 @@ const Field kSchema[] = {
       "10", "", 0, 10000, "", "fewer point constraints than this along a direction: degenerate"),
     F("estimator.degeneracy_rotation_threshold_m2", estimator.degeneracy_rotation_threshold_m2,
       "20", "m^2", 0, 1e6, "", "rotation constraints (squared lever arms) below this: degenerate"),
+    F("estimator.degenerate_information_scale", estimator.degenerate_information_scale, "0.01", "",
+      0, 1, "",
+      "weight of what a degenerate scan says along its degenerate directions (0: nothing; the "
+      "cameras then alone pin them)"),
     F("estimator.plane_voxel_m", estimator.plane_voxel_m, "0.4", "m", 0.05, 5, "",
       "downsampling of planar lidar features"),
     F("estimator.edge_voxel_m", estimator.edge_voxel_m, "0.2", "m", 0.05, 5, "",
@@ -247,10 +251,30 @@ const Field kSchema[] = {
       "a scan this far from the last keyframe is a keyframe (exported map poses)"),
     F("estimator.keyframe_angle_deg", estimator.keyframe_angle_deg, "11.5", "deg", 0.1, 180, "",
       "or turned this much"),
+    F("estimator.camera_coupling", estimator.camera_coupling, "loose", "", 0, 0, "loose|off",
+      "cameras in the estimate: each stream's frame-to-frame motion (lidar depth for scale) as a "
+      "between factor per state (seed 002), or off (the front end only reports)"),
+    F("estimator.camera_pixel_sigma_px", estimator.camera_pixel_sigma_px, "1", "px", 0.05, 20, "",
+      "feature noise of a frame-to-frame motion: its covariance at omega = 1 (Sigma_base)"),
+    F("estimator.camera_quality_weighting", estimator.camera_quality_weighting, "true", "", 0, 0,
+      "", "scale each stream's covariance by omega from its image quality (seed 002)"),
+    F("estimator.camera_min_confidence", estimator.camera_min_confidence, "0.1", "", 0, 1, "",
+      "a stream whose image confidence stays below this (3 frames) leaves the estimate"),
+    F("estimator.camera_rejoin_confidence", estimator.camera_rejoin_confidence, "0.15", "", 0, 1,
+      "", "and returns once it is at or above this for 5 frames"),
+    F("estimator.camera_floor_translation_m", estimator.camera_floor_translation_m, "0.002", "m", 0,
+      1, "", "1-sigma added to each camera factor's translation (features are not independent)"),
+    F("estimator.camera_floor_rotation_deg", estimator.camera_floor_rotation_deg, "0.06", "deg", 0,
+      10, "", "1-sigma added to each camera factor's rotation"),
+    F("estimator.pose_selection", estimator.pose_selection, "true", "", 0, 0, "",
+      "seed 001's adaptive pose selection: each state starts from the lidar, camera or fused "
+      "odometry by the dynamic-threshold rule (false: the IMU prediction)"),
 
     // The visual-thermal front end (core/vision, docs/frontend.md); runs with a camera enabled.
-    F("frontend.mode", frontend.mode, "fused", "", 0, 0, "off|visible|thermal|fused",
-      "which image features are tracked on: visible, thermal, or their DWT fusion (seed 000)"),
+    F("frontend.mode", frontend.mode, "fused", "", 0, 0,
+      "off|visible|thermal|fused|visible+thermal",
+      "which image features are tracked on: visible, thermal, their DWT fusion (seed 000), or "
+      "visible and thermal as two streams, each weighed by its own image quality (seed 002)"),
     F("frontend.enhance_visible", frontend.enhance_visible, "true", "", 0, 0, "",
       "adaptive gamma and CLAHE on the visible image's V channel (seed 001)"),
     F("frontend.gamma_target_mean", frontend.gamma_target_mean, "0.5", "", 0.05, 0.95, "",
@@ -294,6 +318,15 @@ const Field kSchema[] = {
       "", "points kept of each stacked scan (in front of the camera, evenly thinned)"),
     F("frontend.depth_max_span_m", frontend.depth_max_span_m, "2", "m", 0.1, 20, "",
       "a feature's 3 lidar neighbours spanning more than this give no depth (seed 000)"),
+    F("frontend.corner_noise_factor", frontend.corner_noise_factor, "4", "", 0, 1000, "",
+      "a new corner's Shi-Tomasi score must exceed this multiple of the image's median score, the "
+      "noise floor of an untextured image: corners of noise over static shading or a thermal "
+      "camera's fixed pattern never move and would pass for a camera standing still (0: off)"),
+    F("frontend.quality_lambda_n", frontend.quality_lambda_n, "0.5", "1/grey", 0.001, 100, "",
+      "seed 002's lambda_n: omega = lambda_n (sigma_n + lambda_g (1 - g)), the scale of a "
+      "stream's covariance weight"),
+    F("frontend.quality_lambda_g", frontend.quality_lambda_g, "4", "grey", 0, 1000, "",
+      "seed 002's lambda_g: how much the gradient metric g weighs against the noise sigma_n"),
 
     // SCHED_FIFO priorities: the maximum (50) must not exceed LimitRTPRIO in posed.service.
     F("threads.imu_source.priority", threads.imu_source.priority, "0", "", 0, 50, "",

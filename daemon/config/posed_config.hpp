@@ -120,18 +120,18 @@ struct ExtrinsicsSection {
 };
 
 struct FrontendSection {
-  std::string mode = "fused";  ///< off | visible | thermal | fused
+  std::string mode = "fused";  ///< off | visible | thermal | fused | visible+thermal
   bool enhance_visible = true;
   double gamma_target_mean = 0.5;                 ///< [0..1]
   double clahe_clip_limit = 2.0;                  ///< [x uniform bin]
   std::string thermal_registration = "infinity";  ///< infinity | plane | fov_crop | lidar_depth
   double thermal_plane_depth_m = 10;              ///< [m]
-  int thermal_depth_grid_cols = 40;  ///< lidar_depth registration grid [cells]
-  int thermal_depth_grid_rows = 30;  ///< [cells]
+  int thermal_depth_grid_cols = 40;               ///< lidar_depth registration grid [cells]
+  int thermal_depth_grid_rows = 30;               ///< [cells]
   bool rotation_compensation = true;
-  std::string wavelet = "haar";  ///< haar | legall53 | cdf97
-  bool fusion_noise_weighted = true;  ///< false: seed 000's eq. (8) as published
-  bool fusion_denoise = true;  ///< noise-adaptive pre-smoothing of the fusion inputs
+  std::string wavelet = "haar";              ///< haar | legall53 | cdf97
+  bool fusion_noise_weighted = true;         ///< false: seed 000's eq. (8) as published
+  bool fusion_denoise = true;                ///< noise-adaptive pre-smoothing of the fusion inputs
   double fusion_denoise_target_sigma = 2.0;  ///< [grey]
   int max_features = 300;
   double min_feature_distance_px = 20;  ///< [px]
@@ -139,7 +139,10 @@ struct FrontendSection {
   bool lines = false;
   double depth_window_s = 1;  ///< [s]
   int depth_points_per_scan = 20000;
-  double depth_max_span_m = 2;  ///< [m]
+  double depth_max_span_m = 2;       ///< [m]
+  double corner_noise_factor = 4.0;  ///< new corners above this x the median corner score
+  double quality_lambda_n = 0.5;     ///< seed 002's λn: scale of ω [1/grey]
+  double quality_lambda_g = 4.0;     ///< seed 002's λg: weight of the gradient metric in ω [grey]
 };
 
 struct EstimatorSection {
@@ -155,11 +158,20 @@ struct EstimatorSection {
   bool degeneracy_handling = true;    ///< remap degenerate directions to the IMU prediction
   double degeneracy_translation_threshold = 10;  ///< point constraints [1]
   double degeneracy_rotation_threshold_m2 = 20;  ///< squared lever arms [m^2]
+  double degenerate_information_scale = 0.01;    ///< what a scan says along them, weighed [-]
   double plane_voxel_m = 0.4;                    ///< planar features downsampling [m]
   double edge_voxel_m = 0.2;                     ///< edge features downsampling [m]
   double map_radius_m = 120;                     ///< local map kept around the robot [m]
   double keyframe_distance_m = 1.0;              ///< keyframe spacing [m]
   double keyframe_angle_deg = 11.5;              ///< keyframe spacing [deg]
+  std::string camera_coupling = "loose";         ///< loose (between factors) | off (front end only)
+  double camera_pixel_sigma_px = 1.0;            ///< Σ_base of a frame-to-frame motion [px]
+  bool camera_quality_weighting = true;          ///< Σ = ω Σ_base (seed 002); false: ω = 1
+  double camera_min_confidence = 0.1;            ///< a stream below it leaves the estimate [0..1]
+  double camera_rejoin_confidence = 0.15;        ///< and returns at or above it [0..1]
+  double camera_floor_translation_m = 0.002;     ///< 1-sigma floor per factor [m]
+  double camera_floor_rotation_deg = 0.06;       ///< 1-sigma floor per factor [deg]
+  bool pose_selection = true;                    ///< seed 001's adaptive initial value
 };
 
 /// One pipeline thread: SCHED_FIFO priority (0 = normal scheduling) and CPU (-1 = any).

@@ -38,6 +38,7 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.lidar.matcher.handle_degeneracy = e.degeneracy_handling;
   l.lidar.matcher.degeneracy_translation_threshold = e.degeneracy_translation_threshold;
   l.lidar.matcher.degeneracy_rotation_threshold_m2 = e.degeneracy_rotation_threshold_m2;
+  l.lidar.matcher.degenerate_information_scale = e.degenerate_information_scale;
   l.lidar.map_radius_m = e.map_radius_m;
   l.lidar.keyframe_distance_m = e.keyframe_distance_m;
   l.lidar.keyframe_angle_rad = e.keyframe_angle_deg * kDeg;
@@ -48,6 +49,7 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.max_accel_bias_mps2 = e.max_accel_bias_mps2;
   l.max_match_jump_m = e.max_match_jump_m;
   l.max_match_jump_rad = e.max_match_jump_deg * kDeg;
+  l.pose_selection = e.pose_selection;
   return l;
 }
 

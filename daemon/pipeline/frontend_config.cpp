@@ -1,13 +1,14 @@
 #include "daemon/pipeline/frontend_config.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "daemon/pipeline/estimator_config.hpp"
 
 namespace posed::pipeline {
 
 bool frontend_mode(const std::string& name, vision::FrontendMode& mode) {
-  if (name == "visible") {
+  if (name == "visible" || name == kTwoStreams) {
     mode = vision::FrontendMode::kVisible;
   } else if (name == "thermal") {
     mode = vision::FrontendMode::kThermal;
@@ -42,7 +43,12 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   vision::FrontendConfig& f = c.frontend;
   if (!frontend_mode(s.mode, f.mode)) f.mode = vision::FrontendMode::kFused;
   note.clear();
-  if (!has_visible && f.mode != vision::FrontendMode::kThermal) {
+  const bool two_streams = s.mode == kTwoStreams && has_visible && has_thermal;
+  if (two_streams) {
+    // Visible is the primary run (the status's front-end figures); thermal runs beside it on
+    // the same events with its own tracks, quality and factors.
+    c.compare_modes.push_back(vision::FrontendMode::kThermal);
+  } else if (!has_visible && f.mode != vision::FrontendMode::kThermal) {
     note = "no visible camera: the front end runs in thermal mode instead of " + s.mode;
     f.mode = vision::FrontendMode::kThermal;
   } else if (!has_thermal && f.mode != vision::FrontendMode::kVisible) {
@@ -81,8 +87,11 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   f.tracker.max_features = s.max_features;
   f.tracker.min_distance_px = s.min_feature_distance_px;
   f.tracker.ransac_threshold_px = s.ransac_threshold_px;
+  f.tracker.corner_noise_factor = s.corner_noise_factor;
   f.lines = s.lines;
   f.depth.max_span_m = s.depth_max_span_m;
+  f.quality.lambda_n = s.quality_lambda_n;
+  f.quality.lambda_g = s.quality_lambda_g;
 
   c.T_imu_cam = to_isometry(config.extrinsics.T_imu_cam);
   c.T_imu_lidar = to_isometry(config.extrinsics.T_imu_lidar);
@@ -97,6 +106,34 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
                 std::max(config.visible_camera.latency_s, config.thermal_camera.latency_s) + 0.05);
   c.depth.window = Duration::from_seconds(s.depth_window_s);
   c.depth.max_points_per_scan = static_cast<std::size_t>(s.depth_points_per_scan);
+  return c;
+}
+
+fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& config,
+                                                  const fusion::CameraFrontEndConfig& cameras) {
+  const config::EstimatorSection& e = config.estimator;
+  fusion::CameraFactorsConfig c;
+  if (e.camera_coupling != "off") {
+    c.streams[static_cast<std::size_t>(cameras.frontend.mode)] = true;
+    for (const vision::FrontendMode m : cameras.compare_modes) {
+      // Only visible+thermal adds a run that feeds the estimate; comparison runs do not.
+      if (config.frontend.mode == kTwoStreams && m == vision::FrontendMode::kThermal) {
+        c.streams[static_cast<std::size_t>(m)] = true;
+      }
+    }
+  }
+  c.T_imu_sensor[0] = cameras.T_imu_cam;
+  c.T_imu_sensor[2] = cameras.T_imu_cam;
+  // Thermal mode's camera: the thermal camera's origin, the visible camera's axes.
+  c.T_imu_sensor[1] =
+      cameras.T_imu_cam * Eigen::Translation3d(cameras.frontend.T_cam_thermal.translation());
+  c.focal_px = 0.5 * (cameras.frontend.visible_camera.fx + cameras.frontend.visible_camera.fy);
+  c.pixel_sigma_px = e.camera_pixel_sigma_px;
+  c.quality_weighting = e.camera_quality_weighting;
+  c.min_confidence = e.camera_min_confidence;
+  c.rejoin_confidence = std::max(e.camera_rejoin_confidence, e.camera_min_confidence);
+  c.floor_translation_m = e.camera_floor_translation_m;
+  c.floor_rotation_rad = e.camera_floor_rotation_deg * M_PI / 180.0;
   return c;
 }
 

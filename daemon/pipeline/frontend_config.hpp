@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "core/fusion/camera_factors.hpp"
 #include "core/fusion/camera_front_end.hpp"
 #include "daemon/config/posed_config.hpp"
 
@@ -18,7 +19,16 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
                                                      bool has_visible, bool has_thermal,
                                                      bool in_stamp_order, std::string& note);
 
-/// `frontend.mode` as the front end's mode; false for "off".
+/// frontend.mode for two streams: the visible and thermal runs each feed the estimate.
+inline constexpr const char* kTwoStreams = "visible+thermal";
+
+/// The camera back end for the front end `cameras` builds: which streams enter the window
+/// (estimator.camera_coupling, frontend.mode), their cameras in base_link, the noise, quality
+/// weighting and gating of the estimator section.
+fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& config,
+                                                  const fusion::CameraFrontEndConfig& cameras);
+
+/// `frontend.mode` as the front end's (primary) mode; false for "off". visible+thermal: visible.
 bool frontend_mode(const std::string& name, vision::FrontendMode& mode);
 
 /// A camera section as the front end's camera model.

@@ -1,5 +1,6 @@
 #include "daemon/pipeline/pipeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/core/utility.hpp>
 
@@ -30,21 +31,26 @@ std::chrono::nanoseconds block_timeout(const drivers::Source* source) {
                                    : std::chrono::nanoseconds(std::chrono::seconds(1));
 }
 
-/// Lidar-inertial odometry when there is a lidar; IMU-only dead reckoning otherwise.
-std::unique_ptr<FusionCore> make_core(const config::PosedConfig& c, bool have_lidar,
-                                      bool keep_map) {
+/// Lidar-inertial odometry when there is a lidar (also returned as `lio`, for the cameras to
+/// join its window); IMU-only dead reckoning otherwise.
+std::unique_ptr<FusionCore> make_core(const config::PosedConfig& c, bool have_lidar, bool keep_map,
+                                      estimator::LioEstimator*& lio) {
+  lio = nullptr;
   if (have_lidar) {
-    estimator::LioConfig lio = lio_config(c);
-    lio.keep_map = keep_map;
-    return std::make_unique<estimator::LioEstimator>(lio);
+    estimator::LioConfig config = lio_config(c);
+    config.keep_map = keep_map;
+    auto core = std::make_unique<estimator::LioEstimator>(config);
+    lio = core.get();
+    return core;
   }
   return make_strapdown_core(strapdown_config(c));
 }
 
-/// `inner` with the camera front end beside it when a camera runs and the front end is on.
+/// `inner` with the camera front end beside it when a camera runs and the front end is on, and
+/// the cameras in `lio`'s window when it is given and the coupling is on.
 std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
-                                         const config::PosedConfig& c, bool has_visible,
-                                         bool has_thermal, bool in_stamp_order,
+                                         estimator::LioEstimator* lio, const config::PosedConfig& c,
+                                         bool has_visible, bool has_thermal, bool in_stamp_order,
                                          const PipelineOutputs& outputs,
                                          const fusion::CameraAidedCore*& camera_core) {
   camera_core = nullptr;
@@ -53,8 +59,15 @@ std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
   fusion::CameraFrontEndConfig cameras =
       camera_front_end_config(c, has_visible, has_thermal, in_stamp_order, note);
   if (!note.empty()) POSED_LOG_WARN("frontend: %s", note.c_str());
-  cameras.compare_modes = outputs.frontend_compare_modes;
-  auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras);
+  const fusion::CameraFactorsConfig factors = camera_factors_config(c, cameras);
+  for (const vision::FrontendMode m : outputs.frontend_compare_modes) {
+    if (std::find(cameras.compare_modes.begin(), cameras.compare_modes.end(), m) ==
+            cameras.compare_modes.end() &&
+        m != cameras.frontend.mode) {
+      cameras.compare_modes.push_back(m);
+    }
+  }
+  auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras, factors, lio);
   core->cameras().set_observer(outputs.frontend_observer);
   camera_core = core.get();
   return core;
@@ -162,11 +175,13 @@ bool Pipeline::start(std::string& error) {
        {sources_.lidar.get(), sources_.visible.get(), sources_.thermal.get()}) {
     if (s != nullptr && s->live()) in_stamp_order = false;
   }
+  estimator::LioEstimator* lio = nullptr;
+  std::unique_ptr<FusionCore> core =
+      make_core(config_, sources_.lidar != nullptr, outputs_.keep_map, lio);
+  core = with_cameras(std::move(core), lio, config_, sources_.visible != nullptr,
+                      sources_.thermal != nullptr, in_stamp_order, outputs_, camera_core_);
   fusion_stage_ = std::make_unique<FusionStage>(
-      config_,
-      with_cameras(make_core(config_, sources_.lidar != nullptr, outputs_.keep_map), config_,
-                   sources_.visible != nullptr, sources_.thermal != nullptr, in_stamp_order,
-                   outputs_, camera_core_),
+      config_, std::move(core),
       FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get()},
       in_stamp_order, state_queue_, fusion_ready_, state_ready_, *heartbeats_[stage++],
       *fusion_counters_);

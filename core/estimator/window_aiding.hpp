@@ -1,0 +1,39 @@
+#pragma once
+// What another sensor hands the lidar-inertial window for each new state: relative motions of
+// base_link since the previous state, as seed 002's loosely coupled VIO/TIO "between" factors.
+// The camera back end (core/fusion/camera_factors) implements it; LioEstimator asks it once per
+// scan, before the new state joins the window, so the measurements can also take part in
+// choosing the state's initial value (seed 001's adaptive pose selection).
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "core/estimator/sliding_window.hpp"
+#include "core/estimator/window_factor.hpp"
+#include "core/imu/preintegration.hpp"
+
+namespace posed::estimator {
+
+/// T_i_j = T_map_i⁻¹ T_map_j of base_link between the previous state i and the new state j.
+struct RelativeMotion {
+  FactorKind kind = FactorKind::kVisible;
+  Eigen::Isometry3d T_i_j = Eigen::Isometry3d::Identity();
+  /// (rotation, translation), right perturbation of T_i_j
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  /// robust loss scale in whitened units (Huber); 0: plain least squares
+  double huber_sigma = 0;
+};
+
+class WindowAiding {
+ public:
+  virtual ~WindowAiding() = default;
+  /// Appends the relative motions measured between the window's newest state (`window.latest()`,
+  /// optimised) and the state about to be added at `next.stamp`, whose pose `next` is its IMU
+  /// prediction. May append nothing.
+  virtual void relative_motions(const SlidingWindow& window, const imu::ImuState& next,
+                                std::vector<RelativeMotion>& out) = 0;
+  /// Called after every solve with the window as optimised (e.g. for residual statistics).
+  virtual void after_solve(const SlidingWindow& window) { (void)window; }
+};
+
+}  // namespace posed::estimator

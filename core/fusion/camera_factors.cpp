@@ -1,0 +1,198 @@
+#include "core/fusion/camera_factors.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+
+#include "core/math/so3.hpp"
+#include "core/sync/pose_interpolation.hpp"
+
+namespace posed::fusion {
+namespace {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+constexpr estimator::FactorKind kKinds[3] = {estimator::FactorKind::kVisible,
+                                             estimator::FactorKind::kThermal,
+                                             estimator::FactorKind::kFused};
+/// Frames kept per stream: more than a window of states needs at 15-25 Hz.
+constexpr std::size_t kFramesKept = 48;
+
+Eigen::Isometry3d isometry(const imu::ImuState& s) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = s.q_map_imu.normalized().toRotationMatrix();
+  T.translation() = s.p_map_imu_m;
+  return T;
+}
+
+Pose pose(const imu::ImuState& s) { return Pose{s.stamp, s.p_map_imu_m, s.q_map_imu}; }
+
+Eigen::Isometry3d isometry(const Pose& p) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = p.q.normalized().toRotationMatrix();
+  T.translation() = p.p;
+  return T;
+}
+
+/// Adjoint of T for the (rotation, translation) right perturbation T Exp(ξ) = (R Exp(φ), p + R ρ):
+/// T Exp(ξ) T⁻¹ = Exp(Ad(T) ξ).
+Mat6 adjoint(const Eigen::Isometry3d& T) {
+  Mat6 A = Mat6::Zero();
+  const Eigen::Matrix3d R = T.linear();
+  A.topLeftCorner<3, 3>() = R;
+  A.bottomLeftCorner<3, 3>() = so3::skew(T.translation()) * R;
+  A.bottomRightCorner<3, 3>() = R;
+  return A;
+}
+
+const vision::ImageQuality& quality_of(const vision::FrontendFrame& f, std::size_t stream) {
+  return stream == 0 ? f.quality.visible : stream == 1 ? f.quality.thermal : f.quality.fused;
+}
+
+}  // namespace
+
+CameraFactors::CameraFactors(const CameraFactorsConfig& config) : config_(config) {
+  config_.motion.pixel_sigma = config.pixel_sigma_px / config.focal_px;
+  config_.motion.fix_rotation = config.translation_only;
+  config_.motion.min_inliers = config.min_observations;
+  config_.motion.guess_gate = config.guess_gate_px / config.focal_px;
+  for (std::size_t i = 0; i < 3; ++i) {
+    figures_[i].configured = config.streams[i];
+    figures_[i].active = config.streams[i];
+  }
+}
+
+void CameraFactors::gate(std::size_t stream, double confidence) {
+  Stream& s = streams_[stream];
+  VisualStreamFigures& f = figures_[stream];
+  s.below = confidence < config_.min_confidence ? s.below + 1 : 0;
+  s.above = confidence >= config_.rejoin_confidence ? s.above + 1 : 0;
+  if (f.active && s.below >= config_.leave_frames) {
+    f.active = false;
+    ++f.left;
+  } else if (!f.active && s.above >= config_.rejoin_frames) {
+    f.active = true;
+    ++f.rejoined;
+  }
+}
+
+void CameraFactors::add_frame(vision::FrontendMode mode, const vision::FrontendFrame& frame) {
+  const auto stream = static_cast<std::size_t>(mode);
+  if (stream >= 3 || !config_.streams[stream]) return;
+  VisualStreamFigures& f = figures_[stream];
+  ++f.frames;
+  const vision::ImageQuality& q = quality_of(frame, stream);
+  // Without an assessment (quality off) the stream is taken at face value.
+  f.confidence = q.valid ? q.confidence : 1.0;
+  f.omega = config_.quality_weighting && q.valid ? q.omega : 1.0;
+  gate(stream, f.confidence);
+
+  Stream& s = streams_[stream];
+  if (!s.frames.empty() && frame.stamp <= s.frames.back().stamp) return;  // never reordered
+  StoredFrame stored;
+  if (s.frames.size() >= kFramesKept) {
+    stored = std::move(s.frames.front());  // reuse its vector's capacity
+    s.frames.pop_front();
+  }
+  stored.stamp = frame.stamp;
+  stored.omega = f.omega;
+  stored.features.clear();
+  for (const vision::FrontendFeature& feature : frame.features) {
+    // Only features known to move with the world (not fixed to the camera) give its motion.
+    if (!feature.verified || feature.track_length < config_.min_track_length) continue;
+    stored.features.push_back({feature.id, feature.normalised, feature.depth_m});
+  }
+  s.frames.push_back(std::move(stored));
+}
+
+const CameraFactors::StoredFrame* CameraFactors::frame_before(const Stream& s, HostTime t) const {
+  for (auto it = s.frames.rbegin(); it != s.frames.rend(); ++it) {
+    if (it->stamp > t) continue;
+    return t - it->stamp <= config_.max_frame_age ? &*it : nullptr;
+  }
+  return nullptr;
+}
+
+void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
+                                     const imu::ImuState& next,
+                                     std::vector<estimator::RelativeMotion>& out) {
+  if (window.size() < 2) return;  // the frame before the newest state needs the one before it
+  const imu::ImuState h = window.state(window.size() - 2);
+  const imu::ImuState i = window.latest();
+  for (std::size_t stream = 0; stream < 3; ++stream) {
+    if (!config_.streams[stream]) continue;
+    VisualStreamFigures& f = figures_[stream];
+    if (!f.active) {
+      ++f.gated_out;
+      continue;
+    }
+    const StoredFrame* a = frame_before(streams_[stream], i.stamp);
+    const StoredFrame* b = frame_before(streams_[stream], next.stamp);
+    if (a == nullptr || b == nullptr || b->stamp <= a->stamp || a->stamp < h.stamp) {
+      ++f.no_frames;
+      continue;
+    }
+    // base_link at the two frames' stamps, from the window's motion around them.
+    const std::optional<Pose> at_a = interpolate_pose(pose(h), pose(i), a->stamp);
+    const std::optional<Pose> at_b = interpolate_pose(pose(i), pose(next), b->stamp);
+    if (!at_a || !at_b) {
+      ++f.no_frames;
+      continue;
+    }
+    const Eigen::Isometry3d T_map_a = isometry(*at_a), T_map_b = isometry(*at_b);
+    const Eigen::Isometry3d& T_imu_s = config_.T_imu_sensor[stream];
+    const Eigen::Isometry3d predicted_a_b = T_map_a.inverse() * T_map_b;  // base_link, a to b
+    const FrameMotion m = estimate_frame_motion(
+        a->features, b->features, T_imu_s.inverse() * predicted_a_b * T_imu_s, config_.motion);
+    if (!m.ok()) {
+      ++f.failed;
+      continue;
+    }
+    f.inliers = m.inliers;
+    f.reprojection_rms_px = m.rms_sigma * config_.pixel_sigma_px;
+    const Eigen::Isometry3d measured_a_b = T_imu_s * m.T_a_b * T_imu_s.inverse();
+    const Eigen::Isometry3d disagreement = predicted_a_b.inverse() * measured_a_b;
+    if (disagreement.translation().norm() > config_.max_disagreement_m ||
+        so3::log(Eigen::Matrix3d(disagreement.linear())).norm() > config_.max_disagreement_rad) {
+      ++f.implausible;
+      continue;
+    }
+    // T_i_j = (T_i⁻¹ T_a) M (T_b⁻¹ T_j); the measurement's perturbation moves through the
+    // extrinsic and the bridge to state j (right perturbations: Ad of the inverse bridge).
+    const Eigen::Isometry3d bridge_b_j = T_map_b.inverse() * isometry(next);
+    estimator::RelativeMotion motion;
+    motion.kind = kKinds[stream];
+    motion.T_i_j = isometry(i).inverse() * T_map_a * measured_a_b * bridge_b_j;
+    const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
+    const double omega = std::max(a->omega, b->omega);
+    Mat6 covariance = omega * A * m.covariance * A.transpose();
+    covariance.diagonal().tail<3>().array() +=
+        config_.floor_translation_m * config_.floor_translation_m;
+    if (config_.translation_only) {
+      // The rotation was the window's: only the translation is the cameras' information.
+      motion.information.setZero();
+      motion.information.bottomRightCorner<3, 3>() =
+          covariance.bottomRightCorner<3, 3>().ldlt().solve(Eigen::Matrix3d::Identity());
+    } else {
+      covariance.diagonal().head<3>().array() +=
+          config_.floor_rotation_rad * config_.floor_rotation_rad;
+      motion.information = covariance.ldlt().solve(Mat6::Identity());
+    }
+    motion.information = 0.5 * (motion.information + motion.information.transpose());
+    motion.huber_sigma = config_.huber_sigma;
+    out.push_back(motion);
+    ++f.factors;
+  }
+}
+
+void CameraFactors::after_solve(const estimator::SlidingWindow& window) {
+  for (std::size_t stream = 0; stream < 3; ++stream) {
+    if (!config_.streams[stream]) continue;
+    window.residual_norms(kKinds[stream], residuals_);
+    if (residuals_.empty()) continue;
+    auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
+    std::nth_element(residuals_.begin(), mid, residuals_.end());
+    figures_[stream].residual_median = *mid;
+  }
+}
+
+}  // namespace posed::fusion

@@ -1,0 +1,125 @@
+#pragma once
+// The cameras in the estimate (issue 17): each camera stream's frame-to-frame motion, with metric
+// scale from the features' lidar depth, enters the lidar-inertial window as a relative-pose
+// ("between") factor between consecutive states, weighed by the stream's image quality (seed 002:
+// Σ = ω Σ_base, ω from the gradient metric g and the noise σn), and gated out while the images
+// are too poor to trust.
+//
+// Why loosely coupled between factors rather than reprojection factors with inverse depths
+// (VINS-Mono, LVI-SAM's VIS): the front end already gives every feature its lidar depth, so two
+// frames pin the camera's motion on their own (frame_motion.hpp) and a factor of 6 residuals per
+// state carries it; the window stays at 15 coordinates per state and its cost per scan grows by
+// microseconds, where hundreds of reprojection factors and landmark blocks would cost tens of
+// milliseconds on a 2-core robot. The price: a feature seen over many states constrains each
+// consecutive pair, not the whole span at once. Seed 002 makes the same choice for visible and
+// thermal odometry; seed 001's point residuals are the tightly coupled alternative.
+//
+// Timing. States sit at scan ends (10 Hz), frames at 15 Hz (visible) or the visible events
+// (thermal mode runs on them too). For states i and j the factor uses the last frame at or before
+// each state's stamp; the short intervals between a frame and its state are bridged with the
+// window's own motion, interpolated between the neighbouring states (linear in position, SLERP
+// in rotation: seed 002's interpolation), which over tens of milliseconds is good to a millimetre.
+// Frames' stamps are ClockSync's (the D435i's hardware clock; the thermal camera's arrival minus
+// its configured latency). The camera-IMU extrinsic comes from the configuration.
+//
+// Geometry. The visible and fused streams are in the visible camera's frame. The thermal stream
+// tracks the thermal image registered to the visible camera's pixel grid at infinity: its
+// features are rays of a camera at the thermal camera's origin with the visible camera's axes
+// (the front end gives them lidar depth in that frame), so its T_imu_sensor is T_imu_cam
+// translated by T_cam_thermal's translation.
+//
+// Pure and deterministic: it runs on the fusion thread, called in the order of the measurements.
+
+#include <Eigen/Geometry>
+#include <array>
+#include <deque>
+#include <vector>
+
+#include "core/estimator/fusion_core.hpp"
+#include "core/estimator/window_aiding.hpp"
+#include "core/fusion/frame_motion.hpp"
+#include "core/vision/frontend_frame.hpp"
+
+namespace posed::fusion {
+
+struct CameraFactorsConfig {
+  /// which streams feed the estimate (visible, thermal, fused; vision::FrontendMode order)
+  std::array<bool, 3> streams{};
+  /// each stream's camera in base_link (see the header comment for the thermal one)
+  std::array<Eigen::Isometry3d, 3> T_imu_sensor{
+      Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()};
+  /// focal length of the grid the features are in (the visible camera's) [px]
+  double focal_px = 600;
+  /// Σ_base: feature position noise of a frame-to-frame motion [px]
+  double pixel_sigma_px = 1.0;
+  FrameMotionConfig motion;  ///< pixel_sigma and fix_rotation are set from the above and below
+  /// the cameras measure translation only, at the rotation the window (gyro, lidar) gives:
+  /// see frame_motion.hpp's fix_rotation
+  bool translation_only = true;
+  /// features tracked over fewer frames are left out: a young track is often a corner of noise
+  /// that KLT has not yet lost (on the simulated corridor, tracks of 1-2 frames miss the true
+  /// motion by 3 px at the median, tracks of 5 or more by 0.35 px) [1]
+  std::uint32_t min_track_length = 4;
+  /// fewer observations (features with depth, counted in each frame they have it) in a frame
+  /// pair: no motion [1]
+  int min_observations = 8;
+  /// features further than this from where the window's prediction puts them are left out of a
+  /// frame pair's motion (frame_motion.hpp's guess_gate) [px]
+  double guess_gate_px = 3.0;
+  /// Σ = ω Σ_base with ω from the image quality (seed 002); false: ω = 1
+  bool quality_weighting = true;
+  /// a stream whose confidence stays below this for `leave_frames` frames stops contributing,
+  /// and comes back once it is at or above `rejoin_confidence` for `rejoin_frames` frames [0..1]
+  double min_confidence = 0.1;
+  double rejoin_confidence = 0.15;
+  int leave_frames = 3;
+  int rejoin_frames = 5;
+  /// a state uses the last frame at most this much before its stamp [ns]
+  Duration max_frame_age = Duration::from_ms(80);
+  /// 1-sigma floors added to each factor's covariance: a frame pair's features are not
+  /// independent (tracking errors, depth association, time offsets) [rad], [m]
+  double floor_rotation_rad = 0.001;
+  double floor_translation_m = 0.002;
+  /// Huber threshold of the factors in the window [sigma]
+  double huber_sigma = 3.0;
+  /// a motion further than this from the IMU's prediction over one interval is refused [m], [rad]
+  double max_disagreement_m = 0.3;
+  double max_disagreement_rad = 0.1;
+};
+
+class CameraFactors final : public estimator::WindowAiding {
+ public:
+  explicit CameraFactors(const CameraFactorsConfig& config);
+
+  /// A frame of `stream` the front end processed: its features and image quality.
+  void add_frame(vision::FrontendMode stream, const vision::FrontendFrame& frame);
+
+  void relative_motions(const estimator::SlidingWindow& window, const imu::ImuState& next,
+                        std::vector<estimator::RelativeMotion>& out) override;
+  void after_solve(const estimator::SlidingWindow& window) override;
+
+  const std::array<VisualStreamFigures, 3>& figures() const { return figures_; }
+  const CameraFactorsConfig& config() const { return config_; }
+
+ private:
+  struct StoredFrame {
+    HostTime stamp;
+    std::vector<FrameFeature> features;  ///< id order
+    double omega = 1;
+  };
+  struct Stream {
+    std::deque<StoredFrame> frames;  ///< stamp order
+    int below = 0;                   ///< consecutive frames under min_confidence
+    int above = 0;                   ///< consecutive frames at or over rejoin_confidence
+  };
+  /// The last frame of `s` at or before `t`, at most max_frame_age old; null if none.
+  const StoredFrame* frame_before(const Stream& s, HostTime t) const;
+  void gate(std::size_t stream, double confidence);
+
+  CameraFactorsConfig config_;
+  std::array<Stream, 3> streams_;
+  std::array<VisualStreamFigures, 3> figures_{};
+  std::vector<double> residuals_;  // scratch
+};
+
+}  // namespace posed::fusion

@@ -1,0 +1,175 @@
+// The camera back end (core/fusion/camera_factors): from frames of features with lidar depth it
+// hands the window the motion of base_link between two states, bridging the frames' stamps to
+// the states', and gates a stream out while its images are poor and back when they recover.
+
+#include "core/fusion/camera_factors.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/math/so3.hpp"
+
+namespace posed::fusion {
+namespace {
+
+constexpr double kFactorsFocalPx = 600;
+
+/// base_link moving along x at 1 m/s while yawing at 0.2 rad/s, from the origin at t = 0.
+Eigen::Isometry3d truth(double t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = so3::exp(Eigen::Vector3d(0, 0, 0.2 * t));
+  T.translation() = Eigen::Vector3d(t, 0.1 * t * t, 0.0);
+  return T;
+}
+
+imu::ImuState state_at(double t) {
+  const Eigen::Isometry3d T = truth(t);
+  imu::ImuState s;
+  s.stamp = HostTime::from_ns(static_cast<std::int64_t>(std::llround(t * 1e9)));
+  s.p_map_imu_m = T.translation();
+  s.q_map_imu = Eigen::Quaterniond(T.linear());
+  s.v_map_mps = Eigen::Vector3d(1, 0.2 * t, 0);
+  return s;
+}
+
+Eigen::Isometry3d T_imu_cam() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // camera z forward along base_link x
+  T.translation() = Eigen::Vector3d(0.577, 0.0, 0.833);
+  return T;
+}
+
+class FactorsWorld {
+ public:
+  FactorsWorld() {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> x(3, 12), y(-3, 3), z(-0.8, 2.0);
+    for (int i = 0; i < 300; ++i) points_.emplace_back(x(rng), y(rng), z(rng));
+  }
+  /// The frame the camera sees at t: every point in front of it, with its depth.
+  vision::FrontendFrame frame(double t, double confidence) const {
+    vision::FrontendFrame f;
+    f.stamp = HostTime::from_ns(static_cast<std::int64_t>(std::llround(t * 1e9)));
+    f.mode = vision::FrontendMode::kVisible;
+    const Eigen::Isometry3d T_cam_map = (truth(t) * T_imu_cam()).inverse();
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const Eigen::Vector3d p = T_cam_map * points_[i];
+      if (p.z() < 0.5 || std::abs(p.x() / p.z()) > 0.5 || std::abs(p.y() / p.z()) > 0.4) continue;
+      vision::FrontendFeature feature;
+      feature.id = i;
+      feature.normalised = p.hnormalized();
+      feature.depth_m = p.z();
+      feature.verified = true;
+      feature.track_length = 10;
+      f.features.push_back(feature);
+    }
+    f.quality.visible.valid = true;
+    f.quality.visible.confidence = confidence;
+    f.quality.visible.omega = 1.0 / confidence;
+    return f;
+  }
+
+ private:
+  std::vector<Eigen::Vector3d> points_;
+};
+
+CameraFactorsConfig factors_config() {
+  CameraFactorsConfig c;
+  c.streams = {true, false, false};
+  c.T_imu_sensor = {T_imu_cam(), T_imu_cam(), T_imu_cam()};
+  c.focal_px = kFactorsFocalPx;
+  return c;
+}
+
+/// A window with states at 0.0, 0.1, ... `t_last` s, on the truth.
+void fill(estimator::SlidingWindow& w, double t_last) {
+  Eigen::Matrix<double, 15, 1> sigma = Eigen::Matrix<double, 15, 1>::Constant(0.01);
+  w.reset(state_at(0.0), sigma);
+  imu::Preintegration pre(imu::ImuNoise{1e-3, 1e-2, 1e-5, 1e-4}, imu::ImuBias{}, HostTime{});
+  for (double t = 0.1; t <= t_last + 1e-9; t += 0.1) w.add(state_at(t), pre, std::nullopt);
+}
+
+TEST(CameraFactors, MeasuresTheMotionBetweenStatesFromFramesOffTheirStamps) {
+  const FactorsWorld world;
+  CameraFactors factors(factors_config());
+  // Frames at 15 Hz with a phase: none falls on a state's stamp.
+  for (double t = 0.013; t < 0.5; t += 1.0 / 15)
+    factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  fill(window, 0.3);
+  std::vector<estimator::RelativeMotion> motions;
+  factors.relative_motions(window, state_at(0.4), motions);
+  ASSERT_EQ(motions.size(), 1u);
+  EXPECT_EQ(motions[0].kind, estimator::FactorKind::kVisible);
+  const Eigen::Isometry3d expected = truth(0.3).inverse() * truth(0.4);
+  EXPECT_LT((motions[0].T_i_j.translation() - expected.translation()).norm(), 2e-3);
+  // Translation only: the rotation rows carry no information.
+  EXPECT_LT((motions[0].information.topLeftCorner<3, 3>().norm()), 1e-9);
+  EXPECT_GT((motions[0].information.bottomRightCorner<3, 3>().trace()), 1e3);
+  EXPECT_EQ(factors.figures()[0].factors, 1u);
+}
+
+TEST(CameraFactors, APredictionTooSlowIsCorrectedOverTheFramesSpan) {
+  // The window's prediction for the state at 0.4 s has the robot 30 % too slow since 0.3 s (a
+  // degenerate corridor's drift). The frames measure the motion between their stamps; only the
+  // bridge from the last frame (0.346 s) to the state comes from the prediction.
+  const FactorsWorld world;
+  CameraFactors factors(factors_config());
+  for (double t = 0.013; t < 0.5; t += 1.0 / 15) {
+    factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
+  }
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  fill(window, 0.3);
+  imu::ImuState next = state_at(0.4);
+  const Eigen::Vector3d p_03 = truth(0.3).translation();
+  next.p_map_imu_m = p_03 + 0.7 * (next.p_map_imu_m - p_03);
+  std::vector<estimator::RelativeMotion> motions;
+  factors.relative_motions(window, next, motions);
+  ASSERT_EQ(motions.size(), 1u);
+  const Eigen::Isometry3d expected = truth(0.3).inverse() * truth(0.4);
+  const Eigen::Vector3d predicted = truth(0.3).inverse() * next.p_map_imu_m;
+  const double prediction_error = (predicted - expected.translation()).norm();
+  const double error = (motions[0].T_i_j.translation() - expected.translation()).norm();
+  // The bridge is 54 ms of the 100 ms: about that share of the prediction's error remains.
+  EXPECT_LT(error, 0.6 * prediction_error);
+  EXPECT_GT(error, 0.4 * prediction_error);
+}
+
+TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {
+  const FactorsWorld world;
+  CameraFactorsConfig c = factors_config();
+  c.min_confidence = 0.2;
+  c.rejoin_confidence = 0.3;
+  CameraFactors factors(c);
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  double t_frame = 0.013;
+  const auto frames_until = [&](double t, double confidence) {
+    for (; t_frame < t; t_frame += 1.0 / 15) {
+      factors.add_frame(vision::FrontendMode::kVisible, world.frame(t_frame, confidence));
+    }
+  };
+  std::vector<estimator::RelativeMotion> motions;
+  const auto step = [&](double t_state) {
+    motions.clear();
+    fill(window, t_state);
+    factors.relative_motions(window, state_at(t_state + 0.1), motions);
+    return motions.size();
+  };
+  frames_until(0.45, 0.9);
+  EXPECT_EQ(step(0.3), 1u);
+  frames_until(0.85, 0.05);  // blinded: 6 poor frames
+  EXPECT_FALSE(factors.figures()[0].active);
+  EXPECT_EQ(step(0.7), 0u);
+  EXPECT_EQ(factors.figures()[0].gated_out, 1u);
+  frames_until(1.05, 0.25);  // better, but under the rejoin threshold
+  EXPECT_FALSE(factors.figures()[0].active);
+  frames_until(1.55, 0.9);  // recovered
+  EXPECT_TRUE(factors.figures()[0].active);
+  EXPECT_EQ(step(1.4), 1u);
+  EXPECT_EQ(factors.figures()[0].left, 1u);
+  EXPECT_EQ(factors.figures()[0].rejoined, 1u);
+}
+
+}  // namespace
+}  // namespace posed::fusion

@@ -1,0 +1,128 @@
+// The frame-to-frame camera motion from features with lidar depth (core/fusion/frame_motion): the
+// true motion from a poor guess, outliers removed, a covariance that matches the spread of noisy
+// estimates, and nothing from features that do not pin the motion.
+
+#include "core/fusion/frame_motion.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "core/math/so3.hpp"
+
+namespace posed::fusion {
+namespace {
+
+constexpr double kFocalPx = 600;
+
+struct Frames {
+  std::vector<FrameFeature> a, b;
+};
+
+/// `n` points 2-8 m ahead of camera a seen from a and from b = a * T_a_b, with pixel noise
+/// `noise_px` and lidar depth on every `depth_every`-th feature in each frame.
+Frames make_frames(const Eigen::Isometry3d& T_a_b, int n, double noise_px, std::mt19937& rng,
+                   int depth_every = 1) {
+  std::uniform_real_distribution<double> lateral(-0.5, 0.5), depth(2, 8);
+  std::normal_distribution<double> noise(0, noise_px / kFocalPx);
+  Frames f;
+  for (int k = 0; k < n; ++k) {
+    const double z = depth(rng);
+    const Eigen::Vector3d X_a(lateral(rng) * z, 0.6 * lateral(rng) * z, z);
+    const Eigen::Vector3d X_b = T_a_b.inverse() * X_a;
+    const auto id = static_cast<std::uint64_t>(k);
+    FrameFeature fa{id, X_a.hnormalized() + Eigen::Vector2d(noise(rng), noise(rng)), X_a.z()};
+    FrameFeature fb{id, X_b.hnormalized() + Eigen::Vector2d(noise(rng), noise(rng)), X_b.z()};
+    if (k % depth_every != 0) fa.depth_m = std::numeric_limits<double>::quiet_NaN();
+    if ((k + 1) % depth_every != 0) fb.depth_m = std::numeric_limits<double>::quiet_NaN();
+    f.a.push_back(fa);
+    f.b.push_back(fb);
+  }
+  return f;
+}
+
+Eigen::Isometry3d forward_motion() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = so3::exp(Eigen::Vector3d(0.01, -0.02, 0.005));
+  T.translation() = Eigen::Vector3d(0.02, -0.01, 0.12);  // mostly along the optical axis
+  return T;
+}
+
+FrameMotionConfig config() {
+  FrameMotionConfig c;
+  c.pixel_sigma = 1.0 / kFocalPx;
+  return c;
+}
+
+TEST(FrameMotion, FindsTheMotionFromIdentity) {
+  std::mt19937 rng(3);
+  const Eigen::Isometry3d T = forward_motion();
+  const Frames f = make_frames(T, 150, 0.5, rng);
+  const FrameMotion m = estimate_frame_motion(f.a, f.b, Eigen::Isometry3d::Identity(), config());
+  ASSERT_TRUE(m.ok());
+  EXPECT_LT((m.T_a_b.translation() - T.translation()).norm(), 0.003);
+  EXPECT_LT(so3::log(Eigen::Matrix3d(T.linear().transpose() * m.T_a_b.linear())).norm(), 5e-4);
+  EXPECT_EQ(m.observations, 300);                        // both directions
+  EXPECT_NEAR(m.rms_sigma, 0.5 * std::sqrt(2.0), 0.25);  // two frames' noise in each residual
+}
+
+TEST(FrameMotion, DropsFeaturesWithAWrongDepth) {
+  std::mt19937 rng(4);
+  const Eigen::Isometry3d T = forward_motion();
+  Frames f = make_frames(T, 150, 0.3, rng);
+  // A fifth of frame a's depths belong to the wall behind: twice as far.
+  for (std::size_t k = 0; k < f.a.size(); k += 5) f.a[k].depth_m *= 2.0;
+  const FrameMotion m = estimate_frame_motion(f.a, f.b, Eigen::Isometry3d::Identity(), config());
+  ASSERT_TRUE(m.ok());
+  const double error_m = (m.T_a_b.translation() - T.translation()).norm();
+  EXPECT_LT(error_m, 0.004);
+  EXPECT_LT(m.inliers, m.observations);
+  // Kept, the wrong depths pull the motion further off.
+  FrameMotionConfig keep_all = config();
+  keep_all.outlier_sigma = 1e6;
+  keep_all.huber_sigma = 1e6;
+  const FrameMotion all = estimate_frame_motion(f.a, f.b, Eigen::Isometry3d::Identity(), keep_all);
+  ASSERT_TRUE(all.ok());
+  EXPECT_GT((all.T_a_b.translation() - T.translation()).norm(), 1.5 * error_m);
+}
+
+TEST(FrameMotion, CovarianceMatchesTheSpreadOfEstimates) {
+  const Eigen::Isometry3d T = forward_motion();
+  std::mt19937 rng(5);
+  Eigen::Matrix<double, 6, 6> sum = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> predicted = Eigen::Matrix<double, 6, 6>::Zero();
+  const int runs = 300;
+  for (int r = 0; r < runs; ++r) {
+    const Frames f = make_frames(T, 60, 1.0, rng);
+    FrameMotionConfig c = config();
+    c.pixel_sigma = std::sqrt(2.0) / kFocalPx;  // each residual holds two observations' noise
+    c.outlier_sigma = 10;                       // pure Gaussian noise: nothing to reject
+    const FrameMotion m = estimate_frame_motion(f.a, f.b, T, c);
+    ASSERT_TRUE(m.ok());
+    Eigen::Matrix<double, 6, 1> e;
+    e.head<3>() = so3::log(Eigen::Matrix3d(T.linear().transpose() * m.T_a_b.linear()));
+    e.tail<3>() = T.linear().transpose() * (m.T_a_b.translation() - T.translation());
+    sum += e * e.transpose();
+    predicted += m.covariance;
+  }
+  sum /= runs;
+  predicted /= runs;
+  // Both directions use the same features, so the Hessian counts each pair's information about
+  // twice: the spread is larger than predicted, by at most ~2x in variance.
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_GT(sum(i, i), 0.5 * predicted(i, i)) << i;
+    EXPECT_LT(sum(i, i), 3.0 * predicted(i, i)) << i;
+  }
+}
+
+TEST(FrameMotion, TooFewFeaturesWithDepthGiveNothing) {
+  std::mt19937 rng(6);
+  const Frames f = make_frames(forward_motion(), 100, 0.5, rng, 25);  // 4 + 4 with depth
+  const FrameMotion m = estimate_frame_motion(f.a, f.b, Eigen::Isometry3d::Identity(), config());
+  EXPECT_FALSE(m.ok());
+  EXPECT_EQ(m.status, FrameMotionStatus::kTooFewPoints);
+}
+
+}  // namespace
+}  // namespace posed::fusion
