@@ -9,6 +9,9 @@
 //   mine          rough, dark tunnel loop, rocky walls, a few warm machines, headlight only
 //   street_night  large loop between buildings at night: street lights, parked cars (some warm),
 //                 pedestrians, a cold sky
+//   tunnel        a coal mine's straight shotcrete roadway, hundreds of metres, dark (headlight,
+//                 a rare lamp): lidar degenerate along it, texture for the colour camera, warm
+//                 pipes, cables and fittings along it for the thermal camera; uneven floor
 
 #include <cstdint>
 #include <optional>
