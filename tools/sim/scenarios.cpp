@@ -427,8 +427,29 @@ Scenario tunnel(std::uint64_t seed, double duration_s, double g) {
   return s;
 }
 
-constexpr std::array<std::string_view, 5> kNames = {"street_night", "corridor", "mine", "room",
-                                                    "tunnel"};
+Scenario smoke(std::uint64_t seed, double duration_s, double g) {
+  Rng rng;
+  Scenario s = begin_scenario(
+      "smoke", seed, 6,
+      {.ambient = 0.01, .headlight = 1.0, .air_temperature_c = 24, .sky_temperature_c = 25}, rng);
+  // A lit roadway: lamps every 12-20 m.
+  roadway_drive(s, rng, {.lamp_spacing_min_m = 12, .lamp_spacing_max_m = 20, .lamp_intensity = 1.0},
+                duration_s, g);
+  // The smoke comes at 30-45 % of the run, thickens over a few seconds, stays dense for 20-30 %
+  // of the run and clears more slowly (ramps shortened for runs under a minute).
+  SmokeSchedule& smoke = s.world.smoke;
+  const double ramp = std::min(1.0, duration_s / 60.0);
+  smoke.start_s = uniform(rng, 0.30, 0.45) * duration_s;
+  smoke.dense_from_s = smoke.start_s + uniform(rng, 3, 6) * ramp;
+  smoke.dense_to_s = smoke.dense_from_s + uniform(rng, 0.20, 0.30) * duration_s;
+  smoke.clear_s = smoke.dense_to_s + uniform(rng, 4, 8) * ramp;
+  smoke.dense_extinction_per_m = uniform(rng, 2.5, 4.0);
+  smoke.albedo = uniform(rng, 0.2, 0.3);
+  return s;
+}
+
+constexpr std::array<std::string_view, 6> kNames = {"street_night", "corridor", "mine",
+                                                    "room",         "tunnel",   "smoke"};
 
 }  // namespace
 
@@ -441,6 +462,7 @@ std::optional<Scenario> make_scenario(std::string_view name, std::uint64_t seed,
   if (name == "mine") return mine(seed, duration_s, gravity_mps2);
   if (name == "street_night") return street_night(seed, duration_s, gravity_mps2);
   if (name == "tunnel") return tunnel(seed, duration_s, gravity_mps2);
+  if (name == "smoke") return smoke(seed, duration_s, gravity_mps2);
   error = "unknown scenario '" + std::string(name) + "' (";
   for (std::string_view n : kNames) error += std::string(n) + (n == kNames.back() ? ")" : ", ");
   return std::nullopt;

@@ -130,7 +130,7 @@ TEST(Scenarios, OlderScenariosSendTheBytesTheyAlwaysSent) {
 }
 
 TEST(Scenarios, NewScenariosAreAFunctionOfNameSeedAndDuration) {
-  for (const char* name : {"tunnel"}) {
+  for (const char* name : {"tunnel", "smoke"}) {
     std::string error;
     const auto a = make_scenario(name, 2, 120.0, 9.805, error);
     const auto b = make_scenario(name, 2, 120.0, 9.805, error);

@@ -1,5 +1,6 @@
 // Smoke for the colour camera (smoke.hpp): the schedule is zero outside its interval and dense
-// inside, a frame in dense smoke has lost its texture, a world without smoke renders as before.
+// inside, a frame in dense smoke has lost its texture, a world without smoke renders as before,
+// and the `smoke` scenario draws its interval where docs/simulator.md says.
 
 #include "tools/sim/smoke.hpp"
 
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "tests/unit/sim/test_scene.hpp"
+#include "tools/sim/scenarios.hpp"
 #include "tools/sim/visible_camera.hpp"
 
 namespace posed::sim {
@@ -64,6 +66,38 @@ TEST(SmokeSchedule, HeadlightBackscatterIsTheIntegral) {
     EXPECT_LT(headlight_backscatter(sigma), 0.5);  // the σ → ∞ limit
   }
   EXPECT_LT(headlight_backscatter(0.5), headlight_backscatter(3.0));
+}
+
+TEST(SmokeScenario, IntervalWhereTheDocsSayAndNoSmokeElsewhere) {
+  for (const double duration_s : {30.0, 60.0, 120.0, 300.0}) {
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+      std::string error;
+      const auto s = make_scenario("smoke", seed, duration_s, 9.805, error);
+      ASSERT_TRUE(s) << error;
+      const SmokeSchedule& k = s->world.smoke;
+      ASSERT_TRUE(k.any());
+      EXPECT_GE(k.start_s, 0.30 * duration_s);
+      EXPECT_LE(k.start_s, 0.45 * duration_s);
+      EXPECT_GT(k.dense_from_s, k.start_s);
+      EXPECT_GE(k.dense_to_s - k.dense_from_s, 0.20 * duration_s);
+      EXPECT_LE(k.dense_to_s - k.dense_from_s, 0.30 * duration_s);
+      EXPECT_GT(k.clear_s, k.dense_to_s);
+      EXPECT_LT(k.clear_s, duration_s);  // it clears before the end
+      EXPECT_GE(k.dense_extinction_per_m, 2.5);
+      // The same inputs, the same smoke.
+      const auto again = make_scenario("smoke", seed, duration_s, 9.805, error);
+      ASSERT_TRUE(again);
+      EXPECT_EQ(again->world.smoke.start_s, k.start_s);
+      EXPECT_EQ(again->world.smoke.clear_s, k.clear_s);
+    }
+  }
+  for (const std::string_view name : scenario_names()) {
+    if (name == "smoke") continue;
+    std::string error;
+    const auto s = make_scenario(name, 3, 60.0, 9.805, error);
+    ASSERT_TRUE(s) << error;
+    EXPECT_FALSE(s->world.smoke.any()) << name;
+  }
 }
 
 /// A colour camera 3 m in front of a textured wall (shotcrete-like value noise), ambient light
