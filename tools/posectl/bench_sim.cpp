@@ -32,6 +32,9 @@ int bench_sim() {
       {"room_all_rtf", "room", 10, true, true, false, ThermalFormat::kY8},
       {"corridor_all_rtf", "corridor", 10, true, true, false, ThermalFormat::kY8},
       {"mine_all_rtf", "mine", 10, true, true, false, ThermalFormat::kY8},
+      {"tunnel_all_rtf", "tunnel", 10, true, true, false, ThermalFormat::kY8},
+      // Its 10 s hold 2-3 s of dense smoke, from 30-45 % in: the smoke is rendered and timed.
+      {"smoke_all_rtf", "smoke", 10, true, true, false, ThermalFormat::kY8},
   };
   // The schema's defaults are the M2DGR rig of config/posed.yaml, without reading a file.
   const sim::SimRig base_rig = sim::rig_from_config(config::default_config());

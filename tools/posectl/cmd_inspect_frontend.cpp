@@ -3,7 +3,9 @@
 // at full speed, without DDS) with the front end in all three modes at once, visible-only,
 // thermal-only and fused, on the same frame events, and prints them side by side in the form of
 // seed 001's Table 2 (features extracted, tracked, match success rate) with seed 000's lidar
-// depth association and seed 002's image quality. --save-frames writes annotated mosaics.
+// depth association and seed 002's image quality. --save-frames writes annotated mosaics,
+// --timeline the figures of every frame; a simulated recording with a degraded colour view
+// (the smoke scenario) also gets them before, during and after it.
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -20,6 +22,7 @@
 #include "tools/posectl/commands.hpp"
 #include "tools/posectl/frontend_depth_truth.hpp"
 #include "tools/posectl/frontend_snapshots.hpp"
+#include "tools/posectl/frontend_timeline.hpp"
 #include "tools/posectl/terminal_progress.hpp"
 
 namespace posed::posectl {
@@ -120,7 +123,7 @@ int run_inspect_frontend(int argc, char** argv) {
       "the same frames, and prints visible-only, thermal-only and fused side by side: features\n"
       "extracted and tracked, match success rate, lidar depth association, image quality.",
       "posectl inspect frontend"};
-  std::string path, config_path, frames_dir;
+  std::string path, config_path, frames_dir, timeline_path;
   SnapshotOptions snapshots;
   app.add_option("FILE", path, "MCAP recording with visible and/or thermal frames")
       ->required()
@@ -134,6 +137,9 @@ int run_inspect_frontend(int argc, char** argv) {
   app.add_option("--every", snapshots.every_frames, "one mosaic per this many frames of a mode")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-frames", snapshots.max_snapshots, "at most this many mosaics per mode");
+  app.add_option("--timeline", timeline_path,
+                 "write one CSV line per frame and mode here: time (true time since the start "
+                 "for a posectl sim recording), features, confidence and gradient per stream");
   CLI11_PARSE(app, argc, argv);
 
   config::LoadResult loaded =
@@ -173,9 +179,17 @@ int run_inspect_frontend(int argc, char** argv) {
   std::string truth_note;
   std::unique_ptr<FrontendDepthTruth> truth =
       FrontendDepthTruth::for_recording(path, config, truth_note);
+  // A simulated recording whose colour view was degraded for a while (the smoke scenario): the
+  // figures before, during and after it.
+  FrontendTimeline timeline(timeline_path, sim_timing(path));
+  if (!timeline.open(error)) {
+    std::fprintf(stderr, "posectl inspect frontend: %s\n", error.c_str());
+    return 1;
+  }
   FrontendObservers observers;
   observers.add(&observer);
   observers.add(truth.get());
+  observers.add(&timeline);
   pipeline::PipelineOutputs outputs;
   outputs.on_state = [](const NavState&) {};
   outputs.on_status = [](const pipeline::PipelineStatus&) {};
@@ -229,6 +243,11 @@ int run_inspect_frontend(int argc, char** argv) {
               truth ? ("the simulator's world, " + truth->description()).c_str()
                     : ("none: " + truth_note).c_str());
   print_table(columns, truth.get());
+  if (!timeline.finish()) {
+    std::fprintf(stderr, "posectl inspect frontend: writing %s failed\n", timeline_path.c_str());
+    return 1;
+  }
+  if (!timeline_path.empty()) std::printf("\nper-frame figures in %s\n", timeline_path.c_str());
   if (!snapshots.directory.empty()) {
     std::printf("\n%zu annotated frames in %s\n", observer.written().size(),
                 snapshots.directory.c_str());

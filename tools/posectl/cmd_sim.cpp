@@ -159,12 +159,16 @@ int run_sim(int argc, char** argv) {
   options.depth_camera = !no_cameras && (depth || loaded.config.depth_camera.enabled);
   options.noise = !no_noise;
   std::string error;
+  // Built here too for what the recording's metadata says of it (run_simulation builds its own).
+  sim::SmokeSchedule smoke;
   {
     std::string e;
-    if (!sim::make_scenario(scenario, seed, 1.0, rig.gravity_mps2, e)) {
+    const auto built = sim::make_scenario(scenario, seed, duration_s, rig.gravity_mps2, e);
+    if (!built) {
       std::fprintf(stderr, "posectl sim: %s\n", e.c_str());
       return 2;
     }
+    smoke = built->world.smoke;
   }
 
   const auto exact = [](double v) {  // round-trips through strtod
@@ -187,6 +191,16 @@ int run_sim(int argc, char** argv) {
       {"host_epoch_ns", std::to_string(options.host_epoch_ns)},
       {"gravity_mps2", exact(rig.gravity_mps2)},
       {"noise", options.noise ? "true" : "false"}};
+  if (smoke.any()) {
+    // When the colour camera's view was degraded, in true time since the start [s]: from the
+    // first trace of smoke to the last, and the dense part (smoke.hpp).
+    auto& md = ropt.metadata[std::string(sim::kSimMetadataName)];
+    md["visible_degraded_from_s"] = exact(smoke.start_s);
+    md["visible_degraded_to_s"] = exact(smoke.clear_s);
+    md["smoke_dense_from_s"] = exact(smoke.dense_from_s);
+    md["smoke_dense_to_s"] = exact(smoke.dense_to_s);
+    md["smoke_extinction_per_m"] = exact(smoke.dense_extinction_per_m);
+  }
   drivers::recording::Recorder recorder;
   if (!recorder.open(out_path, ropt, error)) {
     std::fprintf(stderr, "posectl sim: %s\n", error.c_str());
@@ -251,6 +265,13 @@ int run_sim(int argc, char** argv) {
       static_cast<unsigned long long>(counters.messages_written),
       static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",
       gt_path.c_str());
+  if (smoke.any()) {
+    std::printf(
+        "  visible degraded (smoke) from %.1f s to %.1f s, dense from %.1f s to %.1f s "
+        "(extinction %.2f /m, visibility %.1f m)\n",
+        smoke.start_s, smoke.clear_s, smoke.dense_from_s, smoke.dense_to_s,
+        smoke.dense_extinction_per_m, 3.0 / smoke.dense_extinction_per_m);
+  }
   return 0;
 }
 

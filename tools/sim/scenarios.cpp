@@ -5,15 +5,14 @@
 #include <numbers>
 #include <random>
 
+#include "tools/sim/roadway.hpp"
+#include "tools/sim/scenario_random.hpp"
+
 namespace posed::sim {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-using Rng = std::mt19937_64;
-
-double uniform(Rng& rng, double a, double b) {
-  return std::uniform_real_distribution<double>(a, b)(rng);
-}
+using Rng = ScenarioRng;
 
 /// Holds and quintic ramps between random cruise speeds, with stops, after a static start.
 SpeedProfile make_speed(Rng& rng, double duration_s, double static_s, double v_min, double v_max,
@@ -96,6 +95,23 @@ PathFrame path_frame(const PeriodicSpline2& path, double u) {
   path.eval(u, p, d1, d2, d3);
   const Eigen::Vector2d t = d1.normalized();
   return {p, t, {-t.y(), t.x()}, std::atan2(t.y(), t.x())};
+}
+
+/// Along x and back: down the right-hand lane (y = -lane) from x = -run to +run, a U-turn of
+/// radius `lane`, back the other lane, a U-turn: a long thin loop starting at (-run, -lane).
+std::vector<Eigen::Vector2d> out_and_back(double run, double lane) {
+  std::vector<Eigen::Vector2d> pts;
+  for (double x = -run; x <= run; x += 10) pts.emplace_back(x, -lane);
+  for (int k = 1; k < 6; ++k) {
+    const double a = -kPi / 2 + kPi * k / 6;
+    pts.emplace_back(run + lane * std::cos(a), lane * std::sin(a));
+  }
+  for (double x = run; x >= -run; x -= 10) pts.emplace_back(x, lane);
+  for (int k = 1; k < 6; ++k) {
+    const double a = kPi / 2 + kPi * k / 6;
+    pts.emplace_back(-run + lane * std::cos(a), lane * std::sin(a));
+  }
+  return pts;
 }
 
 void add_ground(World& w, std::uint32_t material) {
@@ -234,20 +250,8 @@ Scenario corridor(std::uint64_t seed, double duration_s, double g) {
     w.add_aabb({x - 0.6, std::min(y0, y0 - side * 0.02), 0.2},
                {x + 0.6, std::max(y0, y0 - side * 0.02), 0.8}, radiator);
   }
-  // Down one side, U-turn, back the other: a long thin loop.
-  const double run = uniform(rng, 25, 40), lane = half_w - 0.75, turn = lane;
-  std::vector<Eigen::Vector2d> pts;
-  for (double x = -run; x <= run; x += 10) pts.emplace_back(x, -lane);
-  for (int k = 1; k < 6; ++k) {
-    const double a = -kPi / 2 + kPi * k / 6;
-    pts.emplace_back(run + turn * std::cos(a), turn * std::sin(a));
-  }
-  for (double x = run; x >= -run; x -= 10) pts.emplace_back(x, lane);
-  for (int k = 1; k < 6; ++k) {
-    const double a = kPi / 2 + kPi * k / 6;
-    pts.emplace_back(-run + turn * std::cos(a), turn * std::sin(a));
-  }
-  s.trajectory = drive(rng, PeriodicSpline2(pts),
+  const double run = uniform(rng, 25, 40), lane = half_w - 0.75;
+  s.trajectory = drive(rng, PeriodicSpline2(out_and_back(run, lane)),
                        {.v_min_mps = 0.6,
                         .v_max_mps = 1.4,
                         .accel_mps2 = 0.4,
@@ -388,7 +392,64 @@ Scenario street_night(std::uint64_t seed, double duration_s, double g) {
   return s;
 }
 
-constexpr std::array<std::string_view, 4> kNames = {"street_night", "corridor", "mine", "room"};
+/// A coal-mine roadway (roadway.hpp) long enough that the lidar never sees its ends: the
+/// drive's straight legs run from x = -run to +run, the shell 215 m beyond them (the VLP-32C
+/// reaches 200 m), with its small things to 60 m beyond them, on a dusty floor, and the drive
+/// through it. Draws the run, the roadway, then the drive.
+void roadway_drive(Scenario& s, Rng& rng, RoadwayLayout layout, double duration_s, double g) {
+  World& w = s.world;
+  add_ground(w, w.add_material(
+                    {12, 0.15, kTextureNoise, 0.4, w.air_temperature_c + 0.5, 0, {0.8, 0.8, 0.8}}));
+  const double run = uniform(rng, 110, 140);
+  layout.half_length_m = run + 215;
+  layout.detail_half_length_m = run + 60;
+  const RoadwayShape shape = build_roadway(s.world, rng, layout);
+  s.trajectory = drive(rng, PeriodicSpline2(out_and_back(run, shape.clear_half_width_m - 0.75)),
+                       {.v_min_mps = 0.5,
+                        .v_max_mps = 1.5,
+                        .accel_mps2 = 0.5,
+                        .stop_probability = 0.15,
+                        .bump_z_m = 0.02,
+                        .bump_angle_rad = 0.02},
+                       duration_s, g);
+}
+
+Scenario tunnel(std::uint64_t seed, double duration_s, double g) {
+  // A deep mine's ventilation air is warm; rays beyond the cameras' range see more roadway.
+  Rng rng;
+  Scenario s = begin_scenario(
+      "tunnel", seed, 5,
+      {.ambient = 0.003, .headlight = 1.0, .air_temperature_c = 24, .sky_temperature_c = 25}, rng);
+  // A rare dim lamp: the headlight does nearly all the lighting.
+  roadway_drive(s, rng,
+                {.lamp_spacing_min_m = 60, .lamp_spacing_max_m = 120, .lamp_intensity = 0.3},
+                duration_s, g);
+  return s;
+}
+
+Scenario smoke(std::uint64_t seed, double duration_s, double g) {
+  Rng rng;
+  Scenario s = begin_scenario(
+      "smoke", seed, 6,
+      {.ambient = 0.01, .headlight = 1.0, .air_temperature_c = 24, .sky_temperature_c = 25}, rng);
+  // A lit roadway: lamps every 12-20 m.
+  roadway_drive(s, rng, {.lamp_spacing_min_m = 12, .lamp_spacing_max_m = 20, .lamp_intensity = 1.0},
+                duration_s, g);
+  // The smoke comes at 30-45 % of the run, thickens over a few seconds, stays dense for 20-30 %
+  // of the run and clears more slowly (ramps shortened for runs under a minute).
+  SmokeSchedule& smoke = s.world.smoke;
+  const double ramp = std::min(1.0, duration_s / 60.0);
+  smoke.start_s = uniform(rng, 0.30, 0.45) * duration_s;
+  smoke.dense_from_s = smoke.start_s + uniform(rng, 3, 6) * ramp;
+  smoke.dense_to_s = smoke.dense_from_s + uniform(rng, 0.20, 0.30) * duration_s;
+  smoke.clear_s = smoke.dense_to_s + uniform(rng, 4, 8) * ramp;
+  smoke.dense_extinction_per_m = uniform(rng, 2.5, 4.0);
+  smoke.albedo = uniform(rng, 0.2, 0.3);
+  return s;
+}
+
+constexpr std::array<std::string_view, 6> kNames = {"street_night", "corridor", "mine",
+                                                    "room",         "tunnel",   "smoke"};
 
 }  // namespace
 
@@ -400,7 +461,10 @@ std::optional<Scenario> make_scenario(std::string_view name, std::uint64_t seed,
   if (name == "corridor") return corridor(seed, duration_s, gravity_mps2);
   if (name == "mine") return mine(seed, duration_s, gravity_mps2);
   if (name == "street_night") return street_night(seed, duration_s, gravity_mps2);
-  error = "unknown scenario '" + std::string(name) + "' (street_night, corridor, mine, room)";
+  if (name == "tunnel") return tunnel(seed, duration_s, gravity_mps2);
+  if (name == "smoke") return smoke(seed, duration_s, gravity_mps2);
+  error = "unknown scenario '" + std::string(name) + "' (";
+  for (std::string_view n : kNames) error += std::string(n) + (n == kNames.back() ? ")" : ", ");
   return std::nullopt;
 }
 

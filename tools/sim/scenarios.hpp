@@ -9,6 +9,11 @@
 //   mine          rough, dark tunnel loop, rocky walls, a few warm machines, headlight only
 //   street_night  large loop between buildings at night: street lights, parked cars (some warm),
 //                 pedestrians, a cold sky
+//   tunnel        a coal mine's straight shotcrete roadway, hundreds of metres, dark (headlight,
+//                 a rare lamp): lidar degenerate along it, texture for the colour camera, warm
+//                 pipes, cables and fittings along it for the thermal camera; uneven floor
+//   smoke         the same kind of roadway, lit by lamps; part-way through, smoke fills the air
+//                 for the colour camera and clears again (World::smoke; posectl sim records when)
 
 #include <cstdint>
 #include <optional>

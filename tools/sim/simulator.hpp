@@ -104,7 +104,10 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
 /// The wall time the simulated recording claims to start at: 2024-06-01T12:00:00Z [ns].
 inline constexpr std::int64_t kSimWallStartNs = 1'717'243'200'000'000'000;
 /// The Metadata record `posectl sim` writes: scenario, seed, duration_s, host_epoch_ns,
-/// gravity_mps2, noise (make_scenario() rebuilds the world and drive from them).
+/// gravity_mps2, noise (make_scenario() rebuilds the world and drive from them); with smoke
+/// (the `smoke` scenario) also visible_degraded_from_s, visible_degraded_to_s,
+/// smoke_dense_from_s, smoke_dense_to_s [s, true time since the start] and
+/// smoke_extinction_per_m (docs/simulator.md).
 inline constexpr std::string_view kSimMetadataName = "posed.sim";
 
 }  // namespace posed::sim

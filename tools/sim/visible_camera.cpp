@@ -42,8 +42,8 @@ D4xxFrameFacts VisibleCamera::next_metadata(HostTime arrival) const {
 
 void VisibleCamera::emit(std::vector<std::byte>& out) {
   const World& world = scene_.world;
-  const Eigen::Isometry3d T_map_cam =
-      scene_.trajectory.T_map_base(schedule_.true_time(index_)) * config_.T_base_cam;
+  const Duration t_true = schedule_.true_time(index_);
+  const Eigen::Isometry3d T_map_cam = scene_.trajectory.T_map_base(t_true) * config_.T_base_cam;
   render_gbuffer(world, scene_.bvh, rays_, T_map_cam, 150.0, gbuffer_);
   const Eigen::Vector3d o = T_map_cam.translation();
   // Lights that matter for this frame: the 8 nearest within 40 m, in float for the pixel loop
@@ -151,6 +151,25 @@ void VisibleCamera::emit(std::vector<std::byte>& out) {
       L[static_cast<std::size_t>(c)] = static_cast<float>(m.tint_bgr[c]) * (albedo * E + emission);
   };
 
+  // Smoke (smoke.hpp): each pixel keeps exp(-σ·d) of its surface's radiance and sees the
+  // smoke's airlight for the rest. Left out entirely without smoke, so the other scenarios'
+  // frames are computed exactly as before.
+  const double sigma = world.smoke.extinction_per_m(t_true.seconds());
+  float airlight = 0;
+  if (sigma > 0) {
+    double E = world.ambient + world.headlight * headlight_backscatter(sigma);
+    for (std::size_t k = 0; k < n_lights; ++k) {
+      const double d = near[k].first;
+      E += light_intensity[k] * std::exp(-sigma * d) / std::max(d * d, 1.0);
+    }
+    airlight = static_cast<float>(world.smoke.albedo * E);
+  }
+  const auto sigma_f = static_cast<float>(sigma);
+  const auto through_smoke = [&](std::size_t i, std::array<float, 3>& L) {
+    const float T = gbuffer_.box[i] < 0 ? 0.0f : std::exp(-sigma_f * gbuffer_.t_m[i]);
+    for (float& c : L) c = c * T + airlight * (1.0f - T);
+  };
+
   // Exposure: this frame with the gain the auto-exposure chose from the previous one.
   const auto scale = static_cast<float>(255.0 * gain_);
   const float read_noise2 = 2.25f * scale / 255.0f;  // (1.5 DN)² amplified by the gain
@@ -173,6 +192,10 @@ void VisibleCamera::emit(std::vector<std::byte>& out) {
           static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
       radiance(x, y, i, p0);
       radiance(x + 1, y, i + 1, p1);
+      if (sigma > 0) {
+        through_smoke(i, p0);
+        through_smoke(i + 1, p1);
+      }
       sum_y += 0.114f * (p0[0] + p1[0]) + 0.587f * (p0[1] + p1[1]) + 0.299f * (p0[2] + p1[2]);
       expose(p0);
       expose(p1);

@@ -1,9 +1,10 @@
 #pragma once
 // The D435i colour camera on the vehicle: Lambertian shading with ambient light, point lights
 // (street lights, lamps) with inverse-square falloff, a headlight at the camera, emissive
-// surfaces, procedural textures; auto-exposure with a gain limit (so night stays dark and
-// noisy), shot + read noise, YUYV 4:2:2 BT.601 limited range as the D435i's colour node sends
-// it, and the D4xx frame metadata that precedes each frame.
+// surfaces, procedural textures, smoke when the world has some (smoke.hpp); auto-exposure with
+// a gain limit (so night stays dark and noisy), shot + read noise, YUYV 4:2:2 BT.601 limited
+// range as the D435i's colour node sends it, and the D4xx frame metadata that precedes each
+// frame.
 
 #include <Eigen/Geometry>
 #include <cstdint>

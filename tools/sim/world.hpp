@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "tools/sim/smoke.hpp"
+
 namespace posed::sim {
 
 /// What a surface looks like to each sensor.
@@ -77,6 +79,8 @@ struct World {
   double headlight = 0.0;
   /// air temperature: what unheated objects settle to [°C]
   double air_temperature_c = 15.0;
+  /// smoke in the air for the colour camera (the `smoke` scenario); none by default
+  SmokeSchedule smoke;
 
   std::uint32_t add_material(const Material& m) {
     materials.push_back(m);
