@@ -245,6 +245,25 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
       msg.camera.confidence[i] = cam.quality[i].valid ? cam.quality[i].confidence : 0.0;
       msg.camera.omega[i] = cam.quality[i].valid ? cam.quality[i].omega : 0.0;
     }
+    msg.modalities = modality_names(f.modalities);
+    for (std::size_t i = 0; i < 3; ++i) {
+      const VisualStreamFigures& v = f.visual[i];
+      msg.visual[i] = {v.configured,
+                       v.active,
+                       v.omega,
+                       v.confidence,
+                       v.factors,
+                       v.failed + v.no_frames + v.implausible,
+                       v.gated_out,
+                       v.left,
+                       v.rejoined,
+                       v.inliers,
+                       v.reprojection_rms_px,
+                       v.residual_median};
+    }
+    msg.selection = {f.selection.lidar_visual_inertial, f.selection.lidar_inertial,
+                     f.selection.visual_inertial, f.selection.imu_only,
+                     f.selection.last_threshold_m};
     msg.uptime_s = (st.stamp - started).seconds();
     std::string line = std::string(to_string(st.mode));
     for (const auto& s : st.streams) {

@@ -69,6 +69,7 @@ struct VisualStreamFigures {
   bool active = false;          ///< its quality gate is open now
   double omega = 0;             ///< covariance scale of its last frame (1 without weighting) [-]
   double confidence = 0;        ///< image-quality confidence of its last frame [0..1]
+  double gradient = 0;          ///< gradient metric g of its last frame [0..1]
   std::uint64_t frames = 0;     ///< frames it received [1]
   std::uint64_t factors = 0;    ///< between factors it added to the window [1]
   std::uint64_t gated_out = 0;  ///< state intervals skipped while its gate was closed [1]

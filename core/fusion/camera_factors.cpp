@@ -61,11 +61,13 @@ CameraFactors::CameraFactors(const CameraFactorsConfig& config) : config_(config
   }
 }
 
-void CameraFactors::gate(std::size_t stream, double confidence) {
+void CameraFactors::gate(std::size_t stream, double confidence, double gradient) {
   Stream& s = streams_[stream];
   VisualStreamFigures& f = figures_[stream];
-  s.below = confidence < config_.min_confidence ? s.below + 1 : 0;
-  s.above = confidence >= config_.rejoin_confidence ? s.above + 1 : 0;
+  const bool poor = confidence < config_.min_confidence || gradient < config_.min_gradient;
+  const bool good = confidence >= config_.rejoin_confidence && gradient >= config_.rejoin_gradient;
+  s.below = poor ? s.below + 1 : 0;
+  s.above = good ? s.above + 1 : 0;
   if (f.active && s.below >= config_.leave_frames) {
     f.active = false;
     ++f.left;
@@ -84,7 +86,8 @@ void CameraFactors::add_frame(vision::FrontendMode mode, const vision::FrontendF
   // Without an assessment (quality off) the stream is taken at face value.
   f.confidence = q.valid ? q.confidence : 1.0;
   f.omega = config_.quality_weighting && q.valid ? q.omega : 1.0;
-  gate(stream, f.confidence);
+  f.gradient = q.valid ? q.gradient_metric : 1.0;
+  gate(stream, f.confidence, f.gradient);
 
   Stream& s = streams_[stream];
   if (!s.frames.empty() && frame.stamp <= s.frames.back().stamp) return;  // never reordered

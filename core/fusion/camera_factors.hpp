@@ -70,8 +70,12 @@ struct CameraFactorsConfig {
   bool quality_weighting = true;
   /// a stream whose confidence stays below this for `leave_frames` frames stops contributing,
   /// and comes back once it is at or above `rejoin_confidence` for `rejoin_frames` frames [0..1]
-  double min_confidence = 0.1;
-  double rejoin_confidence = 0.15;
+  double min_confidence = 0.05;
+  double rejoin_confidence = 0.08;
+  /// and the same with the gradient metric g alone: smoke or darkness takes an image's edges
+  /// (g near 0) before its noise estimate moves ω [0..1]
+  double min_gradient = 0.02;
+  double rejoin_gradient = 0.04;
   int leave_frames = 3;
   int rejoin_frames = 5;
   /// a state uses the last frame at most this much before its stamp [ns]
@@ -114,7 +118,7 @@ class CameraFactors final : public estimator::WindowAiding {
   };
   /// The last frame of `s` at or before `t`, at most max_frame_age old; null if none.
   const StoredFrame* frame_before(const Stream& s, HostTime t) const;
-  void gate(std::size_t stream, double confidence);
+  void gate(std::size_t stream, double confidence, double gradient);
 
   CameraFactorsConfig config_;
   std::array<Stream, 3> streams_;

@@ -258,10 +258,15 @@ const Field kSchema[] = {
       "feature noise of a frame-to-frame motion: its covariance at omega = 1 (Sigma_base)"),
     F("estimator.camera_quality_weighting", estimator.camera_quality_weighting, "true", "", 0, 0,
       "", "scale each stream's covariance by omega from its image quality (seed 002)"),
-    F("estimator.camera_min_confidence", estimator.camera_min_confidence, "0.1", "", 0, 1, "",
+    F("estimator.camera_min_confidence", estimator.camera_min_confidence, "0.05", "", 0, 1, "",
       "a stream whose image confidence stays below this (3 frames) leaves the estimate"),
-    F("estimator.camera_rejoin_confidence", estimator.camera_rejoin_confidence, "0.15", "", 0, 1,
+    F("estimator.camera_rejoin_confidence", estimator.camera_rejoin_confidence, "0.08", "", 0, 1,
       "", "and returns once it is at or above this for 5 frames"),
+    F("estimator.camera_min_gradient", estimator.camera_min_gradient, "0.02", "", 0, 1, "",
+      "so does a stream whose gradient metric g (seed 002) stays below this: smoke, darkness, a "
+      "covered lens take the edges first"),
+    F("estimator.camera_rejoin_gradient", estimator.camera_rejoin_gradient, "0.04", "", 0, 1, "",
+      "and it returns once g is at or above this (and the confidence above its threshold)"),
     F("estimator.camera_floor_translation_m", estimator.camera_floor_translation_m, "0.002", "m", 0,
       1, "", "1-sigma added to each camera factor's translation (features are not independent)"),
     F("estimator.camera_floor_rotation_deg", estimator.camera_floor_rotation_deg, "0.06", "deg", 0,
@@ -322,10 +327,10 @@ const Field kSchema[] = {
       "a new corner's Shi-Tomasi score must exceed this multiple of the image's median score, the "
       "noise floor of an untextured image: corners of noise over static shading or a thermal "
       "camera's fixed pattern never move and would pass for a camera standing still (0: off)"),
-    F("frontend.quality_lambda_n", frontend.quality_lambda_n, "0.5", "1/grey", 0.001, 100, "",
+    F("frontend.quality_lambda_n", frontend.quality_lambda_n, "0.1", "1/grey", 0.001, 100, "",
       "seed 002's lambda_n: omega = lambda_n (sigma_n + lambda_g (1 - g)), the scale of a "
       "stream's covariance weight"),
-    F("frontend.quality_lambda_g", frontend.quality_lambda_g, "4", "grey", 0, 1000, "",
+    F("frontend.quality_lambda_g", frontend.quality_lambda_g, "10", "grey", 0, 1000, "",
       "seed 002's lambda_g: how much the gradient metric g weighs against the noise sigma_n"),
 
     // SCHED_FIFO priorities: the maximum (50) must not exceed LimitRTPRIO in posed.service.

@@ -141,8 +141,8 @@ struct FrontendSection {
   int depth_points_per_scan = 20000;
   double depth_max_span_m = 2;       ///< [m]
   double corner_noise_factor = 4.0;  ///< new corners above this x the median corner score
-  double quality_lambda_n = 0.5;     ///< seed 002's λn: scale of ω [1/grey]
-  double quality_lambda_g = 4.0;     ///< seed 002's λg: weight of the gradient metric in ω [grey]
+  double quality_lambda_n = 0.1;     ///< seed 002's λn: scale of ω [1/grey]
+  double quality_lambda_g = 10.0;    ///< seed 002's λg: weight of the gradient metric in ω [grey]
 };
 
 struct EstimatorSection {
@@ -167,8 +167,10 @@ struct EstimatorSection {
   std::string camera_coupling = "loose";         ///< loose (between factors) | off (front end only)
   double camera_pixel_sigma_px = 1.0;            ///< Σ_base of a frame-to-frame motion [px]
   bool camera_quality_weighting = true;          ///< Σ = ω Σ_base (seed 002); false: ω = 1
-  double camera_min_confidence = 0.1;            ///< a stream below it leaves the estimate [0..1]
-  double camera_rejoin_confidence = 0.15;        ///< and returns at or above it [0..1]
+  double camera_min_confidence = 0.05;           ///< a stream below it leaves the estimate [0..1]
+  double camera_rejoin_confidence = 0.08;        ///< and returns at or above it [0..1]
+  double camera_min_gradient = 0.02;             ///< or below this gradient metric g [0..1]
+  double camera_rejoin_gradient = 0.04;          ///< [0..1]
   double camera_floor_translation_m = 0.002;     ///< 1-sigma floor per factor [m]
   double camera_floor_rotation_deg = 0.06;       ///< 1-sigma floor per factor [deg]
   bool pose_selection = true;                    ///< seed 001's adaptive initial value

@@ -84,6 +84,28 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
     out.camera.confidence[i] = cam.confidence[i];
     out.camera.omega[i] = cam.omega[i];
   }
+  out.modalities = c_str(msg.modalities);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const VisualStreamStatusMessage& v = msg.visual[i];
+    posed_msgs_msg_dds__VisualStreamStatus_& d = out.visual[i];
+    d.configured = v.configured;
+    d.active = v.active;
+    d.omega = v.omega;
+    d.confidence = v.confidence;
+    d.factors = v.factors;
+    d.failed = v.failed;
+    d.gated_out = v.gated_out;
+    d.left = v.left;
+    d.rejoined = v.rejoined;
+    d.inliers = v.inliers;
+    d.reprojection_rms_px = v.reprojection_rms_px;
+    d.residual_median = v.residual_median;
+  }
+  out.selection.lidar_visual_inertial = msg.selection.lidar_visual_inertial;
+  out.selection.lidar_inertial = msg.selection.lidar_inertial;
+  out.selection.visual_inertial = msg.selection.visual_inertial;
+  out.selection.imu_only = msg.selection.imu_only;
+  out.selection.threshold_m = msg.selection.threshold_m;
   out.uptime_s = msg.uptime_s;
   out.summary = c_str(msg.summary);
   if (streams.size() < msg.streams.size()) streams.resize(msg.streams.size());
@@ -159,6 +181,28 @@ StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
     cam.confidence[i] = in.camera.confidence[i];
     cam.omega[i] = in.camera.omega[i];
   }
+  msg.modalities = to_string(in.modalities);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const posed_msgs_msg_dds__VisualStreamStatus_& v = in.visual[i];
+    VisualStreamStatusMessage& d = msg.visual[i];
+    d.configured = v.configured;
+    d.active = v.active;
+    d.omega = v.omega;
+    d.confidence = v.confidence;
+    d.factors = v.factors;
+    d.failed = v.failed;
+    d.gated_out = v.gated_out;
+    d.left = v.left;
+    d.rejoined = v.rejoined;
+    d.inliers = v.inliers;
+    d.reprojection_rms_px = v.reprojection_rms_px;
+    d.residual_median = v.residual_median;
+  }
+  msg.selection.lidar_visual_inertial = in.selection.lidar_visual_inertial;
+  msg.selection.lidar_inertial = in.selection.lidar_inertial;
+  msg.selection.visual_inertial = in.selection.visual_inertial;
+  msg.selection.imu_only = in.selection.imu_only;
+  msg.selection.threshold_m = in.selection.threshold_m;
   msg.uptime_s = in.uptime_s;
   msg.summary = to_string(in.summary);
   msg.streams.reserve(in.streams._length);

@@ -131,6 +131,31 @@ struct CameraStatusMessage {
   std::array<double, 3> omega{};       ///< visible, thermal, fused in the last frame [-]
 };
 
+/// posed_msgs/VisualStreamStatus: one camera stream in the estimate.
+struct VisualStreamStatusMessage {
+  bool configured = false;
+  bool active = false;             ///< gate open
+  double omega = 0;                ///< [-]
+  double confidence = 0;           ///< [0..1]
+  std::uint64_t factors = 0;       ///< [count]
+  std::uint64_t failed = 0;        ///< [count]
+  std::uint64_t gated_out = 0;     ///< [count]
+  std::uint64_t left = 0;          ///< [count]
+  std::uint64_t rejoined = 0;      ///< [count]
+  std::int32_t inliers = 0;        ///< [count]
+  double reprojection_rms_px = 0;  ///< [px]
+  double residual_median = 0;      ///< [sigma]
+};
+
+/// posed_msgs/PoseSelectionStatus: seed 001's choices of initial value.
+struct PoseSelectionStatusMessage {
+  std::uint64_t lidar_visual_inertial = 0;  ///< [count]
+  std::uint64_t lidar_inertial = 0;         ///< [count]
+  std::uint64_t visual_inertial = 0;        ///< [count]
+  std::uint64_t imu_only = 0;               ///< [count]
+  double threshold_m = 0;                   ///< [m]
+};
+
 /// posed_msgs/Status: published at 1 Hz.
 struct StatusMessage {
   /// time of the report (wall clock, UNIX epoch) [ns]
@@ -141,6 +166,11 @@ struct StatusMessage {
   std::string estimator_mode;
   EstimatorStatusMessage estimator;
   CameraStatusMessage camera;
+  /// what entered the estimate at the last state, e.g. "imu+lidar+visible"
+  std::string modalities;
+  /// visible, thermal, fused
+  std::array<VisualStreamStatusMessage, 3> visual{};
+  PoseSelectionStatusMessage selection;
   /// time since the daemon started [s]
   double uptime_s = 0.0;
   /// one-line human-readable summary

@@ -132,6 +132,8 @@ fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& con
   c.quality_weighting = e.camera_quality_weighting;
   c.min_confidence = e.camera_min_confidence;
   c.rejoin_confidence = std::max(e.camera_rejoin_confidence, e.camera_min_confidence);
+  c.min_gradient = e.camera_min_gradient;
+  c.rejoin_gradient = std::max(e.camera_rejoin_gradient, e.camera_min_gradient);
   c.floor_translation_m = e.camera_floor_translation_m;
   c.floor_rotation_rad = e.camera_floor_rotation_deg * M_PI / 180.0;
   return c;

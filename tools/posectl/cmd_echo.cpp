@@ -239,6 +239,32 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
         100.0 * c.match_success_rate, c.confidence[0], c.confidence[1], c.confidence[2], c.omega[0],
         c.omega[1], c.omega[2]);
   }
+  static constexpr const char* kVisual[] = {"visible", "thermal", "fused"};
+  bool any_visual = false;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const dds::VisualStreamStatusMessage& v = m.visual[i];
+    if (!v.configured) continue;
+    if (!any_visual) std::printf("  estimate   %s at the last state\n", m.modalities.c_str());
+    any_visual = true;
+    std::printf(
+        "  %-10s %s  omega %.2f confidence %.2f  factors %llu failed %llu gated out %llu (left "
+        "%llu, rejoined %llu)  last %d inliers %.2f px  window residual median %.2f sigma\n",
+        kVisual[i], v.active ? "in the estimate" : "gated out", v.omega, v.confidence,
+        static_cast<unsigned long long>(v.factors), static_cast<unsigned long long>(v.failed),
+        static_cast<unsigned long long>(v.gated_out), static_cast<unsigned long long>(v.left),
+        static_cast<unsigned long long>(v.rejoined), v.inliers, v.reprojection_rms_px,
+        v.residual_median);
+  }
+  const dds::PoseSelectionStatusMessage& sel = m.selection;
+  if (sel.lidar_visual_inertial + sel.lidar_inertial + sel.visual_inertial + sel.imu_only > 0) {
+    std::printf(
+        "  selection  initial values: %llu lidar-visual-inertial %llu lidar-inertial %llu "
+        "visual-inertial %llu IMU only  threshold %.3f m\n",
+        static_cast<unsigned long long>(sel.lidar_visual_inertial),
+        static_cast<unsigned long long>(sel.lidar_inertial),
+        static_cast<unsigned long long>(sel.visual_inertial),
+        static_cast<unsigned long long>(sel.imu_only), sel.threshold_m);
+  }
   for (const auto& s : m.streams) {
     std::printf(
         "  %-10s %8.2f Hz  received %llu decoded %llu dropped %llu malformed %llu  clock %s: "

@@ -67,6 +67,7 @@ class FactorsWorld {
     f.quality.visible.valid = true;
     f.quality.visible.confidence = confidence;
     f.quality.visible.omega = 1.0 / confidence;
+    f.quality.visible.gradient_metric = confidence;
     return f;
   }
 
