@@ -333,6 +333,14 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
   begin(LioStep::kFeatures);
   lidar_.extract_features();
   end(LioStep::kFeatures);
+  const bool aided = aiding_ != nullptr && aiding_->active();
+  if (aided != aided_degeneracy_) {
+    aided_degeneracy_ = aided;
+    const lidar::ScanMatcherConfig& m = config_.lidar.matcher;
+    lidar_.set_translation_degeneracy(
+        aided ? config_.aided_degeneracy_translation_threshold : m.degeneracy_translation_threshold,
+        aided ? config_.aided_degenerate_information_scale : m.degenerate_information_scale);
+  }
   begin(LioStep::kMatch);
   lidar::ScanMatchResult match = lidar_.match(T_pred);
   end(LioStep::kMatch);

@@ -54,6 +54,13 @@ struct LioConfig {
   /// a scan match this far from the IMU prediction is refused rather than believed [m]
   double max_match_jump_m = 1.0;
   double max_match_jump_rad = 0.2;  ///< [rad]
+  /// While the aiding (the cameras) is active, a scan is degenerate along a translation it pins
+  /// with fewer point constraints than this, and says nothing along it: in a roadway whose pipes
+  /// and trays run its whole length the lidar "pins" the axis through plane fits tilted by the
+  /// fittings, a confidence the cameras then have to fight (lidar.matcher's own threshold and
+  /// information scale apply otherwise) [1], [-]
+  double aided_degeneracy_translation_threshold = 200;
+  double aided_degenerate_information_scale = 0;
   /// seed 001's adaptive pose selection of each state's initial value (pose_selection.hpp); off:
   /// the IMU prediction
   bool pose_selection = true;
@@ -171,6 +178,7 @@ class LioEstimator final : public FusionCore {
   LioStepProbe* probe_ = nullptr;
   WindowAiding* aiding_ = nullptr;
   std::vector<RelativeMotion> motions_;  // this scan's, from the aiding
+  bool aided_degeneracy_ = false;        // the lidar's degeneracy is set for an active aiding
   void begin(LioStep s) {
     if (probe_ != nullptr) probe_->begin(s);
   }

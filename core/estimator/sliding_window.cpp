@@ -153,7 +153,7 @@ bool SlidingWindow::solve() {
   }
   for (WindowFactor& f : factors_) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   so.max_num_iterations = config_.max_iterations;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;

@@ -32,6 +32,9 @@ class WindowAiding {
   /// prediction. May append nothing.
   virtual void relative_motions(const SlidingWindow& window, const imu::ImuState& next,
                                 std::vector<RelativeMotion>& out) = 0;
+  /// Whether it expects to add motions for the next state (e.g. a camera whose images are good
+  /// enough): the lidar then leaves its weakly constrained directions to it.
+  virtual bool active() const = 0;
   /// Called after every solve with the window as optimised (e.g. for residual statistics).
   virtual void after_solve(const SlidingWindow& window) { (void)window; }
 };

@@ -187,6 +187,13 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
   }
 }
 
+bool CameraFactors::active() const {
+  for (std::size_t stream = 0; stream < 3; ++stream) {
+    if (config_.streams[stream] && figures_[stream].active) return true;
+  }
+  return false;
+}
+
 void CameraFactors::after_solve(const estimator::SlidingWindow& window) {
   for (std::size_t stream = 0; stream < 3; ++stream) {
     if (!config_.streams[stream]) continue;

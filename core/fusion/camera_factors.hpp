@@ -101,6 +101,8 @@ class CameraFactors final : public estimator::WindowAiding {
   void relative_motions(const estimator::SlidingWindow& window, const imu::ImuState& next,
                         std::vector<estimator::RelativeMotion>& out) override;
   void after_solve(const estimator::SlidingWindow& window) override;
+  /// A configured stream's gate is open.
+  bool active() const override;
 
   const std::array<VisualStreamFigures, 3>& figures() const { return figures_; }
   const CameraFactorsConfig& config() const { return config_; }

@@ -59,6 +59,10 @@ class LidarOdometry {
   void map_points(std::vector<Eigen::Vector3f>& out) const;
   const LidarOdometryCounters& counters() const { return counters_; }
   const LidarOdometryConfig& config() const { return config_; }
+  /// See ScanMatcher::set_translation_degeneracy.
+  void set_translation_degeneracy(double threshold, double information_scale) {
+    matcher_.set_translation_degeneracy(threshold, information_scale);
+  }
   /// Forgets the map and keyframes (re-initialisation after divergence).
   void reset();
 

@@ -100,6 +100,12 @@ class ScanMatcher {
   /// The correspondences of the last iteration (for tests and diagnostics).
   const std::vector<Correspondence>& correspondences() const { return correspondences_; }
   const ScanMatcherConfig& config() const { return config_; }
+  /// Changes what counts as degenerate along translations and what a degenerate scan still says
+  /// there, from the next match on (LioEstimator: another sensor pins what the lidar barely does).
+  void set_translation_degeneracy(double threshold, double information_scale) {
+    config_.degeneracy_translation_threshold = threshold;
+    config_.degenerate_information_scale = information_scale;
+  }
 
  private:
   void associate(const std::vector<Eigen::Vector3f>& edges_lidar,

@@ -271,6 +271,15 @@ const Field kSchema[] = {
       1, "", "1-sigma added to each camera factor's translation (features are not independent)"),
     F("estimator.camera_floor_rotation_deg", estimator.camera_floor_rotation_deg, "0.06", "deg", 0,
       10, "", "1-sigma added to each camera factor's rotation"),
+    F("estimator.camera_degeneracy_translation_threshold",
+      estimator.camera_degeneracy_translation_threshold, "200", "", 0, 10000, "",
+      "while a camera stream is in the estimate, a scan is degenerate along translations it pins "
+      "with fewer point constraints than this (pipes and trays along a roadway pin its axis only "
+      "through tilted plane fits; the cameras see it move)"),
+    F("estimator.camera_degenerate_information_scale",
+      estimator.camera_degenerate_information_scale, "0", "", 0, 1, "",
+      "and what such a scan says along those directions is weighed by this (0: the cameras and the "
+      "IMU alone)"),
     F("estimator.pose_selection", estimator.pose_selection, "true", "", 0, 0, "",
       "seed 001's adaptive pose selection: each state starts from the lidar, camera or fused "
       "odometry by the dynamic-threshold rule (false: the IMU prediction)"),

@@ -174,6 +174,8 @@ struct EstimatorSection {
   double camera_floor_translation_m = 0.002;     ///< 1-sigma floor per factor [m]
   double camera_floor_rotation_deg = 0.06;       ///< 1-sigma floor per factor [deg]
   bool pose_selection = true;                    ///< seed 001's adaptive initial value
+  double camera_degeneracy_translation_threshold = 200;  ///< with cameras in the estimate [1]
+  double camera_degenerate_information_scale = 0;        ///< with cameras in the estimate [-]
 };
 
 /// One pipeline thread: SCHED_FIFO priority (0 = normal scheduling) and CPU (-1 = any).

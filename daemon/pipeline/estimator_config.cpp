@@ -50,6 +50,8 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.max_match_jump_m = e.max_match_jump_m;
   l.max_match_jump_rad = e.max_match_jump_deg * kDeg;
   l.pose_selection = e.pose_selection;
+  l.aided_degeneracy_translation_threshold = e.camera_degeneracy_translation_threshold;
+  l.aided_degenerate_information_scale = e.camera_degenerate_information_scale;
   return l;
 }
 

@@ -30,6 +30,9 @@ std::span<const Benchmark> benchmarks() {
                 bench_lio},
       Benchmark{"frontend", "Visual-thermal front end per frame pair on one core, by step",
                 bench_frontend},
+      Benchmark{"backend",
+                "Cameras in the window per state on one core: frame motion, solve with and without",
+                bench_backend},
       Benchmark{"recording", "MCAP write (lz4, one core) and read throughput on /dev/shm",
                 bench_recording},
   };

@@ -36,5 +36,6 @@ int bench_recording();
 int bench_sim();
 int bench_lio();
 int bench_frontend();
+int bench_backend();
 
 }  // namespace posed::posectl
