@@ -82,6 +82,8 @@ struct VisualStreamFigures {
   double reprojection_rms_px = 0;  ///< RMS reprojection error of its last motion [px]
   /// median whitened residual |r| of its factors in the window after the last solve [sigma]
   double residual_median = 0;
+  /// covariance scale from its residuals (CameraFactorsConfig::residual_scaling) [-]
+  double residual_scale = 1;
 };
 
 /// Seed 001's adaptive pose selection: which odometry gave each state its initial value.
@@ -111,7 +113,10 @@ struct FusionFigures {
   std::uint64_t scans_skipped = 0;      ///< scans before alignment or without IMU coverage [1]
   std::uint64_t reinitialisations = 0;  ///< divergences detected and restarted from [1]
   std::uint64_t keyframes = 0;          ///< scans added to the map as keyframes [1]
-  int degenerate_directions = 0;        ///< in the last scan's match [1]
+  /// translation directions where a scan's weak information was dropped for disagreeing with
+  /// the cameras [1]
+  std::uint64_t lidar_directions_overruled = 0;
+  int degenerate_directions = 0;                              ///< in the last scan's match [1]
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  ///< current estimate [rad/s]
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]
   /// the camera front end's figures (mode empty without one)

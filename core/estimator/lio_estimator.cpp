@@ -3,6 +3,7 @@
 #include <ceres/loss_function.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -435,6 +436,7 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   }
   motions_.clear();
   if (aiding_ != nullptr) aiding_->relative_motions(window_, predicted, motions_);
+  if (lidar_factor && !motions_.empty()) reconcile(*lidar_factor);
   const imu::ImuState initial = initial_value(predicted, pre, match);
   const std::uint64_t previous = window_.latest_id();
   window_.add(initial, pre, lidar_factor);
@@ -452,6 +454,54 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   window_.solve();
   if (aiding_ != nullptr) aiding_->after_solve(window_);
   figures_.modalities = modalities;
+}
+
+void LioEstimator::reconcile(LidarPose& lidar) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  const imu::ImuState previous = window_.latest();
+  const Eigen::Matrix3d R_i = previous.q_map_imu.toRotationMatrix();
+  // The lidar's position of the new state relative to the previous one, in the previous frame.
+  const Eigen::Isometry3d T_map_imu = lidar.T_map_lidar * config_.T_imu_lidar.inverse();
+  const Eigen::Vector3d p_lidar =
+      R_i.transpose() * (T_map_imu.translation() - previous.p_map_imu_m);
+  // The cameras' combined translation and information in the same frame.
+  Eigen::Matrix3d I_cam = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b_cam = Eigen::Vector3d::Zero();
+  for (const RelativeMotion& m : motions_) {
+    const Eigen::Matrix3d I = covariance_of(m.information).bottomRightCorner<3, 3>().inverse();
+    // The factor's translation residual is in the measured frame: R_meas I R_measᵀ in frame i.
+    const Eigen::Matrix3d R_m = m.T_i_j.linear();
+    I_cam += R_m * I * R_m.transpose();
+    b_cam += R_m * I * R_m.transpose() * m.T_i_j.translation();
+  }
+  const Eigen::Vector3d p_cam = (I_cam + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(b_cam);
+  // The lidar's translation information in frame i (right perturbation: lidar axes at j).
+  const Eigen::Matrix3d R_map_lidar = lidar.T_map_lidar.linear();
+  const Eigen::Matrix3d R_i_lidar = R_i.transpose() * R_map_lidar;
+  const Eigen::Matrix3d I_lidar_body = lidar.information.bottomRightCorner<3, 3>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(
+      0.5 * (I_lidar_body + I_lidar_body.transpose()));
+  Mat6 P = Mat6::Identity();
+  for (int k = 0; k < 3; ++k) {
+    const double lambda = es.eigenvalues()(k);
+    if (lambda >= config_.aided_trusted_information) continue;  // the scan pins it firmly
+    const Eigen::Vector3d e_lidar = es.eigenvectors().col(k);
+    const Eigen::Vector3d e_i = R_i_lidar * e_lidar;
+    const double I_c = e_i.dot(I_cam * e_i);
+    if (I_c <= 0) continue;  // the cameras say nothing along it
+    const double difference = e_i.dot(p_lidar - p_cam);
+    const double variance = (lambda > 0 ? 1.0 / lambda : 1e9) + 1.0 / I_c;
+    if (difference * difference <=
+        config_.aided_consistency_sigma * config_.aided_consistency_sigma * variance) {
+      continue;
+    }
+    // The scan and the cameras disagree along a direction the scan pins only weakly: an
+    // aliased match (a roadway's uniform pipes) more often than a camera error, since the
+    // cameras' motion passed its own checks. The scan says nothing there.
+    P.block<3, 3>(3, 3) -= e_lidar * e_lidar.transpose();
+    ++figures_.lidar_directions_overruled;
+  }
+  lidar.information = P * lidar.information * P.transpose();
 }
 
 imu::ImuState LioEstimator::initial_value(const imu::ImuState& predicted,

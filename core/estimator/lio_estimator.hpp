@@ -59,8 +59,14 @@ struct LioConfig {
   /// and trays run its whole length the lidar "pins" the axis through plane fits tilted by the
   /// fittings, a confidence the cameras then have to fight (lidar.matcher's own threshold and
   /// information scale apply otherwise) [1], [-]
-  double aided_degeneracy_translation_threshold = 200;
+  double aided_degeneracy_translation_threshold = 10;
   double aided_degenerate_information_scale = 0;
+  /// A scan's translation information below this along a direction (200 point constraints at
+  /// the matcher's 5 cm residual sigma) is checked against the cameras' motion for the same
+  /// interval; where they disagree beyond `aided_consistency_sigma` the scan says nothing along
+  /// it (reconcile()) [1/m²], [sigma]
+  double aided_trusted_information = 8e4;
+  double aided_consistency_sigma = 3.0;
   /// seed 001's adaptive pose selection of each state's initial value (pose_selection.hpp); off:
   /// the IMU prediction
   bool pose_selection = true;
@@ -123,6 +129,9 @@ class LioEstimator final : public FusionCore {
   /// from the initial value the pose selection chose; the window is solved.
   void add_to_window(const imu::ImuState& predicted, const imu::Preintegration& pre,
                      const lidar::ScanMatchResult& match);
+  /// Drops the scan's information along weakly pinned translations where it disagrees with the
+  /// aiding's motions for this interval (see aided_trusted_information).
+  void reconcile(LidarPose& lidar);
   /// Seed 001's choice among the IMU prediction, the scan match and the aiding's motions.
   imu::ImuState initial_value(const imu::ImuState& predicted, const imu::Preintegration& pre,
                               const lidar::ScanMatchResult& match);

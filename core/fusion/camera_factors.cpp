@@ -166,7 +166,7 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
     motion.kind = kKinds[stream];
     motion.T_i_j = isometry(i).inverse() * T_map_a * measured_a_b * bridge_b_j;
     const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
-    const double omega = std::max(a->omega, b->omega);
+    const double omega = std::max(a->omega, b->omega) * residual_scale_[stream];
     Mat6 covariance = omega * A * m.covariance * A.transpose();
     covariance.diagonal().tail<3>().array() +=
         config_.floor_translation_m * config_.floor_translation_m;
@@ -202,6 +202,16 @@ void CameraFactors::after_solve(const estimator::SlidingWindow& window) {
     auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
     std::nth_element(residuals_.begin(), mid, residuals_.end());
     figures_[stream].residual_median = *mid;
+    if (config_.residual_scaling) {
+      // One solve's median over the window's factors of this stream; a slow running mean, so
+      // one poor window does not swing the weights.
+      constexpr double kAgreeingMedian = 1.54, kRate = 0.05;
+      const double observed = (*mid / kAgreeingMedian) * (*mid / kAgreeingMedian);
+      double& scale = residual_scale_[stream];
+      // The residuals are whitened with the scale already applied: the next scale is relative.
+      scale = std::clamp(scale * (1.0 + kRate * (observed - 1.0)), 1.0, config_.residual_scale_max);
+      figures_[stream].residual_scale = scale;
+    }
   }
 }
 

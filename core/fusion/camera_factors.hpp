@@ -86,6 +86,13 @@ struct CameraFactorsConfig {
   double floor_translation_m = 0.002;
   /// Huber threshold of the factors in the window [sigma]
   double huber_sigma = 3.0;
+  /// scale each stream's covariance by how far its factors disagree with the rest of the window:
+  /// the running mean of (median whitened residual / 1.54)², 1.54 being the median of a
+  /// 3-degree-of-freedom residual that agrees (variance component estimation). Image quality
+  /// says how sharp a stream's features are, not whether they are where the stream thinks
+  /// (a thermal image whose borders or fixed pattern hold still, a lens model slightly off)
+  bool residual_scaling = false;
+  double residual_scale_max = 1000;  ///< [-]
   /// a motion further than this from the IMU's prediction over one interval is refused [m], [rad]
   double max_disagreement_m = 0.3;
   double max_disagreement_rad = 0.1;
@@ -125,7 +132,8 @@ class CameraFactors final : public estimator::WindowAiding {
   CameraFactorsConfig config_;
   std::array<Stream, 3> streams_;
   std::array<VisualStreamFigures, 3> figures_{};
-  std::vector<double> residuals_;  // scratch
+  std::array<double, 3> residual_scale_{1.0, 1.0, 1.0};  // per stream, see residual_scaling
+  std::vector<double> residuals_;                        // scratch
 };
 
 }  // namespace posed::fusion

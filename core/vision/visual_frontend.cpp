@@ -141,7 +141,13 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
           cv::bitwise_not(aligner_->valid_mask(), missing);
           visible_grey_.copyTo(thermal_grey_, missing);
         } else {
-          detect_mask = aligner_->valid_mask();
+          // Corners on the edge of what the thermal lens covers hold still in the image however
+          // the camera moves: keep new corners a KLT window away from it.
+          const int margin = config_.tracker.klt_window_px;
+          cv::erode(aligner_->valid_mask(), thermal_detect_mask_,
+                    cv::getStructuringElement(cv::MORPH_RECT,
+                                              cv::Size(2 * margin + 1, 2 * margin + 1)));
+          detect_mask = thermal_detect_mask_;
         }
       }
     }

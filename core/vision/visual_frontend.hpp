@@ -122,7 +122,8 @@ class VisualFrontend {
 
   cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, thermal_native_, fused_grey_;
   cv::Mat thermal_native_enhanced_;
-  cv::Mat visible_denoised_, thermal_denoised_;  // fusion inputs when FusionConfig::denoise
+  cv::Mat visible_denoised_, thermal_denoised_;
+  cv::Mat thermal_detect_mask_;  // thermal mode: where new corners may be found  // fusion inputs when FusionConfig::denoise
   // previous frame's features (id order) for the velocities
   std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> previous_;
   HostTime previous_stamp_;

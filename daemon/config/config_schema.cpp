@@ -258,6 +258,10 @@ const Field kSchema[] = {
       "feature noise of a frame-to-frame motion: its covariance at omega = 1 (Sigma_base)"),
     F("estimator.camera_quality_weighting", estimator.camera_quality_weighting, "true", "", 0, 0,
       "", "scale each stream's covariance by omega from its image quality (seed 002)"),
+    F("estimator.camera_residual_scaling", estimator.camera_residual_scaling, "false", "", 0, 0, "",
+      "also scale each stream's covariance by how far its factors disagree with the rest of the "
+      "window (a running variance component estimate): image quality cannot see a stream whose "
+      "features are sharp but not where it thinks"),
     F("estimator.camera_min_confidence", estimator.camera_min_confidence, "0.05", "", 0, 1, "",
       "a stream whose image confidence stays below this (3 frames) leaves the estimate"),
     F("estimator.camera_rejoin_confidence", estimator.camera_rejoin_confidence, "0.08", "", 0, 1,
@@ -272,14 +276,22 @@ const Field kSchema[] = {
     F("estimator.camera_floor_rotation_deg", estimator.camera_floor_rotation_deg, "0.06", "deg", 0,
       10, "", "1-sigma added to each camera factor's rotation"),
     F("estimator.camera_degeneracy_translation_threshold",
-      estimator.camera_degeneracy_translation_threshold, "200", "", 0, 10000, "",
+      estimator.camera_degeneracy_translation_threshold, "10", "", 0, 10000, "",
       "while a camera stream is in the estimate, a scan is degenerate along translations it pins "
-      "with fewer point constraints than this (pipes and trays along a roadway pin its axis only "
-      "through tilted plane fits; the cameras see it move)"),
+      "with fewer point constraints than this (as degeneracy_translation_threshold otherwise)"),
     F("estimator.camera_degenerate_information_scale",
       estimator.camera_degenerate_information_scale, "0", "", 0, 1, "",
-      "and what such a scan says along those directions is weighed by this (0: the cameras and the "
-      "IMU alone)"),
+      "and what such a scan says along its degenerate directions is weighed by this (0: the "
+      "cameras "
+      "and the IMU alone; degenerate_information_scale otherwise)"),
+    F("estimator.camera_lidar_trusted_constraints", estimator.camera_lidar_trusted_constraints,
+      "200", "", 0, 1e6, "",
+      "a scan's translation pinned by fewer point constraints than this is checked against the "
+      "cameras' motion for the same interval"),
+    F("estimator.camera_lidar_consistency_sigma", estimator.camera_lidar_consistency_sigma, "3", "",
+      0.5, 100, "",
+      "where the scan and the cameras disagree by more than this, the scan says nothing along "
+      "that direction (an aliased match, e.g. a roadway's uniform pipes)"),
     F("estimator.pose_selection", estimator.pose_selection, "true", "", 0, 0, "",
       "seed 001's adaptive pose selection: each state starts from the lidar, camera or fused "
       "odometry by the dynamic-threshold rule (false: the IMU prediction)"),

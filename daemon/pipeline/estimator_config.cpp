@@ -52,6 +52,11 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.pose_selection = e.pose_selection;
   l.aided_degeneracy_translation_threshold = e.camera_degeneracy_translation_threshold;
   l.aided_degenerate_information_scale = e.camera_degenerate_information_scale;
+  // The matcher's information is point constraints over its residual variance.
+  l.aided_trusted_information =
+      e.camera_lidar_trusted_constraints /
+      (l.lidar.matcher.residual_sigma_m * l.lidar.matcher.residual_sigma_m);
+  l.aided_consistency_sigma = e.camera_lidar_consistency_sigma;
   return l;
 }
 

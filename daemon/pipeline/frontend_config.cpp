@@ -130,6 +130,7 @@ fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& con
   c.focal_px = 0.5 * (cameras.frontend.visible_camera.fx + cameras.frontend.visible_camera.fy);
   c.pixel_sigma_px = e.camera_pixel_sigma_px;
   c.quality_weighting = e.camera_quality_weighting;
+  c.residual_scaling = e.camera_residual_scaling;
   c.min_confidence = e.camera_min_confidence;
   c.rejoin_confidence = std::max(e.camera_rejoin_confidence, e.camera_min_confidence);
   c.min_gradient = e.camera_min_gradient;

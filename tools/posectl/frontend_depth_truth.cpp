@@ -17,6 +17,9 @@ struct FrontendDepthTruth::World {
   std::unique_ptr<sim::Bvh> bvh;
   std::int64_t host_epoch_ns = 0;
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  /// thermal mode's camera: the thermal camera's origin with the visible camera's axes (its
+  /// features are rays of the thermal image registered to the visible grid at infinity)
+  Eigen::Isometry3d T_base_thermal_origin = Eigen::Isometry3d::Identity();
 };
 
 namespace {
@@ -73,6 +76,9 @@ std::unique_ptr<FrontendDepthTruth> FrontendDepthTruth::for_recording(
   truth->world_->bvh = std::make_unique<sim::Bvh>(truth->world_->scenario.world);
   truth->world_->host_epoch_ns = static_cast<std::int64_t>(epoch_ns);
   truth->world_->T_base_cam = pipeline::to_isometry(config.extrinsics.T_imu_cam);
+  truth->world_->T_base_thermal_origin =
+      truth->world_->T_base_cam *
+      Eigen::Translation3d(pipeline::to_isometry(config.extrinsics.T_cam_thermal).translation());
   char text[128];
   std::snprintf(text, sizeof text, "%s seed %.0f, %.1f s", scenario->second.c_str(), seed,
                 duration_s);
@@ -87,7 +93,9 @@ void FrontendDepthTruth::on_frame(const vision::FrontendFrame& frame,
   const double t_s = static_cast<double>(frame.stamp.ns - world_->host_epoch_ns) * 1e-9;
   const sim::TrajectorySample s = world_->scenario.trajectory.at(t_s);
   const Eigen::Isometry3d T_map_cam =
-      Eigen::Translation3d(s.p_map_base_m) * s.q_map_base * world_->T_base_cam;
+      Eigen::Translation3d(s.p_map_base_m) * s.q_map_base *
+      (frame.mode == vision::FrontendMode::kThermal ? world_->T_base_thermal_origin
+                                                    : world_->T_base_cam);
   const Eigen::Isometry3d T_cam_map = T_map_cam.inverse();
   for (const vision::FrontendFeature& f : frame.features) {
     if (std::isnan(f.depth_m)) continue;
