@@ -465,8 +465,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     std::printf(
         "  camera front end    %s: %llu frames (%llu unusable, %llu without IMU), %.0f "
         "features/frame, match success %.1f %%, lidar depth for %.1f %% of features, %llu tracks "
-        "dropped as fixed to the camera; mean confidence visible %.2f, thermal %.2f, fused "
-        "%.2f\n",
+        "dropped as fixed to the camera, %llu frozen thermal frames left out; mean confidence "
+        "visible %.2f, thermal %.2f, fused %.2f\n",
         std::string(c.mode).c_str(), static_cast<unsigned long long>(c.frames),
         static_cast<unsigned long long>(c.frames_unusable),
         static_cast<unsigned long long>(c.frames_without_imu),
@@ -474,7 +474,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
         c.features_total > 0
             ? 100.0 * static_cast<double>(c.depth_total) / static_cast<double>(c.features_total)
             : 0.0,
-        static_cast<unsigned long long>(c.static_dropped_total), c.mean_confidence[0],
+        static_cast<unsigned long long>(c.static_dropped_total),
+        static_cast<unsigned long long>(c.thermal_frozen), c.mean_confidence[0],
         c.mean_confidence[1], c.mean_confidence[2]);
   }
   print_visual_summary(st.estimator);

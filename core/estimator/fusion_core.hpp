@@ -43,6 +43,9 @@ struct CameraFigures {
   std::uint64_t extracted_total = 0;     ///< new features detected, summed [1]
   std::uint64_t features_total = 0;      ///< features output, summed [1]
   std::uint64_t depth_total = 0;         ///< of those, with lidar depth, summed [1]
+  /// thermal frames identical to the one before (shutter closed for the flat-field correction),
+  /// left out [1]
+  std::uint64_t thermal_frozen = 0;
   /// tracks dropped for staying put while the camera turned (fixed to the camera), summed [1]
   std::uint64_t static_dropped_total = 0;
   int features = 0;          ///< in the last frame [1]

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <cmath>
 
 #include "core/math/so3.hpp"
 #include "core/sync/pose_interpolation.hpp"
@@ -144,8 +145,10 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
     const Eigen::Isometry3d T_map_a = isometry(*at_a), T_map_b = isometry(*at_b);
     const Eigen::Isometry3d& T_imu_s = config_.T_imu_sensor[stream];
     const Eigen::Isometry3d predicted_a_b = T_map_a.inverse() * T_map_b;  // base_link, a to b
+    FrameMotionConfig motion_config = config_.motion;
+    motion_config.gate_falls_back = stream == 0 || !config_.thermal_gate_strict;  // 0: visible
     const FrameMotion m = estimate_frame_motion(
-        a->features, b->features, T_imu_s.inverse() * predicted_a_b * T_imu_s, config_.motion);
+        a->features, b->features, T_imu_s.inverse() * predicted_a_b * T_imu_s, motion_config);
     if (!m.ok()) {
       ++f.failed;
       continue;
@@ -195,6 +198,8 @@ bool CameraFactors::active() const {
 }
 
 void CameraFactors::after_solve(const estimator::SlidingWindow& window) {
+  std::array<double, 3> unscaled{};  // medians whitened at Σ_base ω, before the residual scale
+  std::array<bool, 3> have{};
   for (std::size_t stream = 0; stream < 3; ++stream) {
     if (!config_.streams[stream]) continue;
     window.residual_norms(kKinds[stream], residuals_);
@@ -202,16 +207,26 @@ void CameraFactors::after_solve(const estimator::SlidingWindow& window) {
     auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
     std::nth_element(residuals_.begin(), mid, residuals_.end());
     figures_[stream].residual_median = *mid;
-    if (config_.residual_scaling) {
-      // One solve's median over the window's factors of this stream; a slow running mean, so
-      // one poor window does not swing the weights.
-      constexpr double kAgreeingMedian = 1.54, kRate = 0.05;
-      const double observed = (*mid / kAgreeingMedian) * (*mid / kAgreeingMedian);
-      double& scale = residual_scale_[stream];
-      // The residuals are whitened with the scale already applied: the next scale is relative.
-      scale = std::clamp(scale * (1.0 + kRate * (observed - 1.0)), 1.0, config_.residual_scale_max);
-      figures_[stream].residual_scale = scale;
-    }
+    unscaled[stream] = *mid * std::sqrt(residual_scale_[stream]);
+    have[stream] = true;
+  }
+  if (!config_.residual_scaling) return;
+  // Streams are weighed against each other, not against the lidar: with one stream (or where
+  // every stream disagrees with a lidar that aliases) nothing changes. A stream whose factors sit
+  // k times further from the solution than the best stream's gets k² its covariance, reached
+  // slowly (5 % per solve, geometrically) so one poor window does not swing the weights.
+  double best = 0;
+  for (std::size_t s = 0; s < 3; ++s) {
+    if (have[s] && (best == 0 || unscaled[s] < best)) best = unscaled[s];
+  }
+  if (best <= 0) return;
+  constexpr double kRate = 0.05;
+  for (std::size_t s = 0; s < 3; ++s) {
+    if (!have[s]) continue;
+    const double target =
+        std::clamp((unscaled[s] / best) * (unscaled[s] / best), 1.0, config_.residual_scale_max);
+    residual_scale_[s] *= std::pow(target / residual_scale_[s], kRate);
+    figures_[s].residual_scale = residual_scale_[s];
   }
 }
 

@@ -66,6 +66,9 @@ struct CameraFactorsConfig {
   /// features further than this from where the window's prediction puts them are left out of a
   /// frame pair's motion (frame_motion.hpp's guess_gate) [px]
   double guess_gate_px = 3.0;
+  /// the thermal and fused streams' gates never fall back to all observations
+  /// (FrameMotionConfig::gate_falls_back): their fixed pattern can be the majority
+  bool thermal_gate_strict = true;
   /// Σ = ω Σ_base with ω from the image quality (seed 002); false: ω = 1
   bool quality_weighting = true;
   /// a stream whose confidence stays below this for `leave_frames` frames stops contributing,
@@ -86,12 +89,12 @@ struct CameraFactorsConfig {
   double floor_translation_m = 0.002;
   /// Huber threshold of the factors in the window [sigma]
   double huber_sigma = 3.0;
-  /// scale each stream's covariance by how far its factors disagree with the rest of the window:
-  /// the running mean of (median whitened residual / 1.54)², 1.54 being the median of a
-  /// 3-degree-of-freedom residual that agrees (variance component estimation). Image quality
-  /// says how sharp a stream's features are, not whether they are where the stream thinks
-  /// (a thermal image whose borders or fixed pattern hold still, a lens model slightly off)
-  bool residual_scaling = false;
+  /// scale each stream's covariance by how far its factors sit from the solution compared with
+  /// the best stream's (their median whitened residuals, squared; a variance component
+  /// estimate between the cameras). Image quality says how sharp a stream's features are, not
+  /// whether they are where the stream thinks (a thermal image whose fixed pattern or lens edge
+  /// holds still). Against the lidar it would blame the wrong sensor where the lidar aliases.
+  bool residual_scaling = true;
   double residual_scale_max = 1000;  ///< [-]
   /// a motion further than this from the IMU's prediction over one interval is refused [m], [rad]
   double max_disagreement_m = 0.3;

@@ -98,7 +98,36 @@ void CameraFrontEnd::process(const Eigen::Vector3d& gyro_bias_radps) {
   if (!imu_.empty()) imu_.discard_before(imu_.newest_stamp() - Duration::from_s(2));
 }
 
+namespace {
+
+/// FNV-1a over an image's rows (its padding excluded).
+std::uint64_t image_hash(const Image& image) {
+  const std::span<const std::byte> bytes = image.pixels.bytes();
+  const std::size_t row = image.stride, rows = image.height;
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::size_t r = 0; r < rows && (r + 1) * row <= bytes.size(); ++r) {
+    for (std::size_t i = r * row; i < (r + 1) * row; ++i) {
+      h = (h ^ static_cast<std::uint64_t>(bytes[i])) * 1099511628211ull;
+    }
+  }
+  return h;
+}
+
+}  // namespace
+
 void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps) {
+  // A thermal camera repeats its last frame while its shutter is closed for the flat-field
+  // correction (the PLUG 617 for about 0.3 s every minute or two): every feature would hold
+  // still while the robot moves. A frame identical to the last is no view of the present.
+  if (e.thermal) {
+    const std::uint64_t hash = image_hash(*e.thermal);
+    const bool frozen = last_thermal_hash_ && *last_thermal_hash_ == hash;
+    last_thermal_hash_ = hash;
+    if (frozen) {
+      e.thermal.reset();
+      for (Run& run : runs_) ++run.figures.thermal_frozen;
+    }
+  }
   vision::FrontendInput input =
       vision::make_input(e.visible ? &*e.visible : nullptr, e.thermal ? &*e.thermal : nullptr);
   input.visible_stamp = e.visible ? e.visible->stamp : e.stamp;

@@ -125,6 +125,7 @@ class CameraFrontEnd {
   /// the same points from the thermal camera's origin (thermal mode's camera, see run_event)
   std::vector<Eigen::Vector3f> p_thermal_origin_m_;
   std::vector<std::uint64_t> fixed_ids_;
+  std::optional<std::uint64_t> last_thermal_hash_;  ///< of the last thermal frame processed
 };
 
 }  // namespace posed::fusion

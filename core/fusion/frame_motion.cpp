@@ -85,9 +85,12 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
       inlier[k] = residual(obs[k], R, p, config.min_depth_m, r, J) && r.norm() <= config.guess_gate;
       kept += inlier[k];
     }
-    if (kept < config.min_inliers || 2 * kept < static_cast<int>(obs.size())) {
-      std::fill(inlier.begin(), inlier.end(), std::uint8_t{1});
+    const bool few = kept < config.min_inliers || 2 * kept < static_cast<int>(obs.size());
+    if (few && !config.gate_falls_back && kept < config.min_inliers) {
+      out.status = FrameMotionStatus::kTooFewInliers;
+      return out;
     }
+    if (few && config.gate_falls_back) std::fill(inlier.begin(), inlier.end(), std::uint8_t{1});
   }
   for (int round = 0; round < 2; ++round) {
     for (int it = 0; it < config.iterations; ++it) {

@@ -46,6 +46,11 @@ struct FrameMotionConfig {
   /// window's velocity is good to a fraction of a pixel over a tenth of a second, while a
   /// feature that does not move with the world misses it by its whole flow [normalised]
   double guess_gate = 0;
+  /// with fewer than half of the observations inside guess_gate, trust the majority and use them
+  /// all (a guess gone stale after a jolt); false: fewer than min_inliers inside is no estimate.
+  /// A thermal image's fixed pattern on uniform walls can be most of its features, all holding
+  /// still while the robot moves: there the majority must not decide
+  bool gate_falls_back = true;
 };
 
 enum class FrameMotionStatus : std::uint8_t {

@@ -35,9 +35,10 @@ std::string_view to_string(FrontendStatus status);
 /// One tracked point feature. Geometry is always the visible camera's (thermal-only mode tracks
 /// the registered thermal image), so the back end needs one camera model.
 struct FrontendFeature {
-  std::uint64_t id = 0;        ///< stable while tracked, never reused
-  Eigen::Vector2f pixel_px;    ///< in the distorted visible image [px]
-  Eigen::Vector2d normalised;  ///< undistorted (x/z, y/z) in the visible camera frame [-]
+  std::uint64_t id = 0;                                ///< stable while tracked, never reused
+  Eigen::Vector2f pixel_px = Eigen::Vector2f::Zero();  ///< in the distorted visible image [px]
+  /// undistorted (x/z, y/z) in the visible camera frame [-]
+  Eigen::Vector2d normalised = Eigen::Vector2d::Zero();
   /// depth z in the visible camera frame from the lidar [m]; NaN when not associated
   double depth_m = std::numeric_limits<double>::quiet_NaN();
   DepthStatus depth_status = DepthStatus::kNoPoints;

@@ -258,10 +258,15 @@ const Field kSchema[] = {
       "feature noise of a frame-to-frame motion: its covariance at omega = 1 (Sigma_base)"),
     F("estimator.camera_quality_weighting", estimator.camera_quality_weighting, "true", "", 0, 0,
       "", "scale each stream's covariance by omega from its image quality (seed 002)"),
-    F("estimator.camera_residual_scaling", estimator.camera_residual_scaling, "false", "", 0, 0, "",
-      "also scale each stream's covariance by how far its factors disagree with the rest of the "
-      "window (a running variance component estimate): image quality cannot see a stream whose "
-      "features are sharp but not where it thinks"),
+    F("estimator.camera_residual_scaling", estimator.camera_residual_scaling, "true", "", 0, 0, "",
+      "with two camera streams, also scale each one's covariance by how far its factors sit from "
+      "the solution compared with the other's (a variance component estimate): image quality "
+      "cannot see a stream whose features are sharp but not where it thinks"),
+    F("estimator.camera_thermal_gate_strict", estimator.camera_thermal_gate_strict, "true", "", 0,
+      0, "",
+      "a thermal or fused frame pair whose features mostly miss where the IMU puts them gives "
+      "no motion (the visible stream then trusts the majority): a thermal camera's fixed pattern "
+      "on uniform walls holds still while the robot moves"),
     F("estimator.camera_min_confidence", estimator.camera_min_confidence, "0.05", "", 0, 1, "",
       "a stream whose image confidence stays below this (3 frames) leaves the estimate"),
     F("estimator.camera_rejoin_confidence", estimator.camera_rejoin_confidence, "0.08", "", 0, 1,
@@ -297,7 +302,7 @@ const Field kSchema[] = {
       "odometry by the dynamic-threshold rule (false: the IMU prediction)"),
 
     // The visual-thermal front end (core/vision, docs/frontend.md); runs with a camera enabled.
-    F("frontend.mode", frontend.mode, "fused", "", 0, 0,
+    F("frontend.mode", frontend.mode, "visible", "", 0, 0,
       "off|visible|thermal|fused|visible+thermal",
       "which image features are tracked on: visible, thermal, their DWT fusion (seed 000), or "
       "visible and thermal as two streams, each weighed by its own image quality (seed 002)"),

@@ -120,7 +120,7 @@ struct ExtrinsicsSection {
 };
 
 struct FrontendSection {
-  std::string mode = "fused";  ///< off | visible | thermal | fused | visible+thermal
+  std::string mode = "visible";  ///< off | visible | thermal | fused | visible+thermal
   bool enhance_visible = true;
   double gamma_target_mean = 0.5;                 ///< [0..1]
   double clahe_clip_limit = 2.0;                  ///< [x uniform bin]
@@ -167,14 +167,15 @@ struct EstimatorSection {
   std::string camera_coupling = "loose";         ///< loose (between factors) | off (front end only)
   double camera_pixel_sigma_px = 1.0;            ///< Σ_base of a frame-to-frame motion [px]
   bool camera_quality_weighting = true;          ///< Σ = ω Σ_base (seed 002); false: ω = 1
-  bool camera_residual_scaling = false;          ///< and by their disagreement with the window
-  double camera_min_confidence = 0.05;           ///< a stream below it leaves the estimate [0..1]
-  double camera_rejoin_confidence = 0.08;        ///< and returns at or above it [0..1]
-  double camera_min_gradient = 0.02;             ///< or below this gradient metric g [0..1]
-  double camera_rejoin_gradient = 0.04;          ///< [0..1]
-  double camera_floor_translation_m = 0.002;     ///< 1-sigma floor per factor [m]
-  double camera_floor_rotation_deg = 0.06;       ///< 1-sigma floor per factor [deg]
-  bool pose_selection = true;                    ///< seed 001's adaptive initial value
+  bool camera_residual_scaling = true;        ///< and by their disagreement with the other stream
+  bool camera_thermal_gate_strict = true;     ///< thermal majority off the IMU's guess: no motion
+  double camera_min_confidence = 0.05;        ///< a stream below it leaves the estimate [0..1]
+  double camera_rejoin_confidence = 0.08;     ///< and returns at or above it [0..1]
+  double camera_min_gradient = 0.02;          ///< or below this gradient metric g [0..1]
+  double camera_rejoin_gradient = 0.04;       ///< [0..1]
+  double camera_floor_translation_m = 0.002;  ///< 1-sigma floor per factor [m]
+  double camera_floor_rotation_deg = 0.06;    ///< 1-sigma floor per factor [deg]
+  bool pose_selection = true;                 ///< seed 001's adaptive initial value
   double camera_degeneracy_translation_threshold = 10;  ///< with cameras in the estimate [1]
   double camera_degenerate_information_scale = 0;       ///< with cameras in the estimate [-]
   double camera_lidar_trusted_constraints = 200;  ///< above: a scan's direction is not checked [1]

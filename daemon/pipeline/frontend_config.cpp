@@ -131,6 +131,7 @@ fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& con
   c.pixel_sigma_px = e.camera_pixel_sigma_px;
   c.quality_weighting = e.camera_quality_weighting;
   c.residual_scaling = e.camera_residual_scaling;
+  c.thermal_gate_strict = e.camera_thermal_gate_strict;
   c.min_confidence = e.camera_min_confidence;
   c.rejoin_confidence = std::max(e.camera_rejoin_confidence, e.camera_min_confidence);
   c.min_gradient = e.camera_min_gradient;

@@ -60,8 +60,11 @@ struct Rig {
   }
 };
 
-/// Hands 3 s of a still rig to `front` in stamp order; returns the visible frames sent.
-int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar) {
+/// Hands 3 s of a still rig to `front` in stamp order; returns the visible frames sent. Thermal
+/// frames stamped in [freeze_from_us, freeze_to_us) repeat the one before, byte for byte (the
+/// shutter closed for a flat-field correction).
+int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar,
+                  std::int64_t freeze_from_us = -1, std::int64_t freeze_to_us = -1) {
   const auto vis_cam = scene::m2dgr_visible();
   const auto th_cam = scene::m2dgr_thermal();
   const cv::Mat visible = scene::render_wall(
@@ -83,6 +86,7 @@ int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar) {
   int visible_sent = 0;
   std::uint64_t scan_index = 0;
   int noise_seed = 1;
+  std::uint64_t thermal_seed = 1000;
   for (std::int64_t t_us = 0; t_us <= 3'000'000; ++t_us) {
     const HostTime t = HostTime::from_ns(t_us * 1000);
     if (t_us % 5000 == 0) {
@@ -109,10 +113,10 @@ int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar) {
       ++visible_sent;
     }
     if (with_thermal && t_us % 40'000 == 11'000) {
-      front.add_image(
-          CameraStream::kThermal,
-          to_image(scene::add_noise(thermal, 1.0, static_cast<std::uint64_t>(noise_seed++)), t,
-                   thermal_pool));
+      const bool frozen = t_us >= freeze_from_us && t_us < freeze_to_us;
+      if (!frozen) ++thermal_seed;
+      front.add_image(CameraStream::kThermal,
+                      to_image(scene::add_noise(thermal, 1.0, thermal_seed), t, thermal_pool));
     }
     if (t_us % 1000 == 0) front.process(Eigen::Vector3d::Zero());
   }
@@ -152,6 +156,7 @@ TEST(CameraFrontEnd, FusedModeTracksEveryPairedFrameAndTheOtherModesCompareOnThe
   EXPECT_GT(fused.depth_total, fused.features_total / 2);
   EXPECT_GT(observer.depths, 1000);
   EXPECT_LT(observer.worst_depth_error_m, 0.05);
+  EXPECT_EQ(fused.thermal_frozen, 0u);
   // Both streams and the fusion were assessed.
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_TRUE(fused.quality[i].valid) << i;
@@ -172,6 +177,19 @@ TEST(CameraFrontEnd, WithoutThermalFramesFusedEventsAreUnusableAndVisibleModeRun
   EXPECT_EQ(visible.frames, fused.frames_unusable);
   EXPECT_GT(visible.features, 150);
   EXPECT_EQ(visible.depth_total, 0u);  // no lidar, no depth
+}
+
+TEST(CameraFrontEnd, FrozenThermalFramesAreLeftOut) {
+  Rig rig;
+  rig.config.frontend.mode = vision::FrontendMode::kThermal;
+  CameraFrontEnd front(rig.config);
+  // Half a second of repeated thermal frames: the 8 events of the visible camera's 15 Hz in it
+  // pair with thermal frames, the first with the new one, the 7 after it with repeats.
+  run_still_rig(front, /*with_thermal=*/true, /*with_lidar=*/true, 1'000'000, 1'500'000);
+  const CameraFigures& thermal = front.figures();
+  EXPECT_EQ(thermal.thermal_frozen, 7u);
+  EXPECT_EQ(thermal.frames_unusable, 7u);
+  EXPECT_GT(thermal.frames, 30u);
 }
 
 }  // namespace

@@ -124,5 +124,49 @@ TEST(FrameMotion, TooFewFeaturesWithDepthGiveNothing) {
   EXPECT_EQ(m.status, FrameMotionStatus::kTooFewPoints);
 }
 
+/// `moving` features that move with the world and `fixed` ones that hold still in the image (a
+/// thermal camera's fixed pattern), appended after them.
+Frames with_fixed_pattern(const Eigen::Isometry3d& T, int moving, int fixed, std::mt19937& rng) {
+  Frames f = make_frames(T, moving, 0.3, rng);
+  const Frames still = make_frames(Eigen::Isometry3d::Identity(), fixed, 0.3, rng);
+  for (std::size_t k = 0; k < still.a.size(); ++k) {
+    FrameFeature a = still.a[k], b = still.b[k];
+    a.id = b.id = 1000 + k;
+    f.a.push_back(a);
+    f.b.push_back(b);
+  }
+  return f;
+}
+
+TEST(FrameMotion, AStrictGateIgnoresAStillMajority) {
+  std::mt19937 rng(7);
+  const Eigen::Isometry3d T = forward_motion();
+  const Frames f = with_fixed_pattern(T, 40, 100, rng);
+  FrameMotionConfig c = config();
+  c.guess_gate = 3.0 / kFocalPx;
+  // The guess (the IMU's) is right: the moving minority passes the gate, the still majority not.
+  c.gate_falls_back = false;
+  const FrameMotion strict = estimate_frame_motion(f.a, f.b, T, c);
+  ASSERT_TRUE(strict.ok());
+  EXPECT_LT((strict.T_a_b.translation() - T.translation()).norm(), 0.004);
+  // Falling back, the majority decides: the camera stood still.
+  c.gate_falls_back = true;
+  const FrameMotion lenient = estimate_frame_motion(f.a, f.b, T, c);
+  ASSERT_TRUE(lenient.ok());
+  EXPECT_GT((lenient.T_a_b.translation() - T.translation()).norm(), 0.05);
+}
+
+TEST(FrameMotion, AStrictGateWithTooFewInsideGivesNothing) {
+  std::mt19937 rng(8);
+  const Eigen::Isometry3d T = forward_motion();
+  const Frames f = with_fixed_pattern(T, 5, 100, rng);
+  FrameMotionConfig c = config();
+  c.guess_gate = 3.0 / kFocalPx;
+  c.gate_falls_back = false;
+  const FrameMotion m = estimate_frame_motion(f.a, f.b, T, c);
+  EXPECT_FALSE(m.ok());
+  EXPECT_EQ(m.status, FrameMotionStatus::kTooFewInliers);
+}
+
 }  // namespace
 }  // namespace posed::fusion

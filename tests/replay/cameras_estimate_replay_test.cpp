@@ -1,0 +1,130 @@
+// The cameras in the estimate, end to end as a user runs it: `posectl sim` writes a short drive
+// down the simulated coal-mine roadway (`tunnel`: its lidar geometry is the same along its axis,
+// its shotcrete walls are textured for the colour camera), `posed --replay --max-speed --record`
+// runs it with the visible camera's motion in the window, twice, and once with the cameras off.
+// The lidar alone loses the axis; with the camera the poses follow the ground truth, and the two
+// camera replays are bit-identical.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <map>
+#include <regex>
+
+#include "drivers/recording/mcap_reader.hpp"
+#include "drivers/recording/ros2_messages.hpp"
+#include "tests/integration/posed_process.hpp"
+#include "tools/eval/umeyama.hpp"
+
+namespace posed::testing {
+// Named rather than anonymous: test binaries build as unity batches.
+namespace cameras_estimate_replay_test {
+
+using namespace std::chrono_literals;
+namespace rec = drivers::recording;
+
+int test_domain() { return 1 + static_cast<int>((::getpid() + 37) % 99); }
+
+/// The messages of `topic` in a recording, decoded, by stamp [ns].
+std::map<std::int64_t, rec::ros2::StampedPose> read_poses(const std::string& path,
+                                                          const std::string& topic, bool odometry) {
+  rec::McapReader reader;
+  std::string error;
+  EXPECT_TRUE(reader.open(path, error)) << error;
+  std::map<std::int64_t, rec::ros2::StampedPose> out;
+  rec::McapMessage m;
+  while (reader.next(m)) {
+    if (m.channel->topic != topic) continue;
+    rec::ros2::StampedPose p;
+    const bool ok = odometry ? rec::ros2::decode_odometry(m.data, p)
+                             : rec::ros2::decode_pose_stamped(m.data, p);
+    EXPECT_TRUE(ok);
+    out[p.stamp.ns] = p;
+  }
+  return out;
+}
+
+Eigen::Vector3d xyz(const rec::ros2::StampedPose& p) {
+  return {p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]};
+}
+
+/// ATE RMSE [m] of `estimate` against `truth` (matched within 5 ms) after SE(3) alignment.
+double ate_m(const std::map<std::int64_t, rec::ros2::StampedPose>& estimate,
+             const std::map<std::int64_t, rec::ros2::StampedPose>& truth) {
+  std::vector<Eigen::Vector3d> est, gt;
+  for (const auto& [stamp, p] : estimate) {
+    auto it = truth.lower_bound(stamp - 5'000'000);
+    if (it == truth.end() || std::llabs(it->first - stamp) > 5'000'000) continue;
+    est.push_back(xyz(p));
+    gt.push_back(xyz(it->second));
+  }
+  EXPECT_GT(est.size(), estimate.size() * 9 / 10);
+  const eval::Sim3 T = eval::umeyama(est, gt, false);
+  double sq = 0;
+  for (std::size_t i = 0; i < est.size(); ++i) sq += (T.apply(est[i]) - gt[i]).squaredNorm();
+  return std::sqrt(sq / static_cast<double>(est.size()));
+}
+
+struct Replay {
+  std::map<std::int64_t, rec::ros2::StampedPose> poses;
+  std::string summary;
+};
+
+Replay replay(TempDir& dir, const std::string& recording, const std::string& mode,
+              const std::string& name) {
+  const std::string config = dir.write(
+      name + ".yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
+                          "\n  cyclonedds_config: " + source_dir() +
+                          "/config/cyclonedds-loopback.xml\nfrontend:\n  mode: " + mode + "\n");
+  PosedProcess posed(
+      {build_dir() + "/daemon/posed", "--config", config, "--replay", recording, "--max-speed",
+       "--wait-subscribers", "0", "--record", dir.file(name + ".mcap")},
+      {}, dir);
+  EXPECT_EQ(posed.wait_for_exit(300s), 0) << posed.err();
+  return {read_poses(dir.file(name + ".mcap"), "/posed/pose", false), posed.out()};
+}
+
+TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
+  TempDir dir;
+  const std::string recording = dir.file("tunnel.mcap");
+  {
+    PosedProcess sim(
+        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "tunnel", "--duration", "30",
+         "--seed", "4", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+        {}, dir);
+    ASSERT_EQ(sim.wait_for_exit(300s), 0) << sim.err();
+  }
+  const auto truth = read_poses(recording, "/posed/ground_truth", true);
+  const Replay a = replay(dir, recording, "visible", "a");
+  const Replay b = replay(dir, recording, "visible", "b");
+  const Replay lio = replay(dir, recording, "off", "lio");
+  ASSERT_GT(a.poses.size(), 250u);  // 10 Hz after the 2 s standing start
+
+  // The camera is in the estimate, and says so.
+  EXPECT_NE(a.summary.find("visible motion in the window"), std::string::npos) << a.summary;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(a.summary, m, std::regex(R"(visible +factors +(\d+) between)")))
+      << a.summary;
+  EXPECT_GT(std::stoi(m[1]), 200);
+  EXPECT_NE(a.summary.find("imu+lidar+visible"), std::string::npos) << a.summary;
+
+  // Bit-identical replays with the camera in the estimate.
+  ASSERT_EQ(a.poses.size(), b.poses.size());
+  for (auto ia = a.poses.begin(), ib = b.poses.begin(); ia != a.poses.end(); ++ia, ++ib) {
+    ASSERT_EQ(ia->first, ib->first);
+    ASSERT_EQ(ia->second.p_xyz_m, ib->second.p_xyz_m);
+    ASSERT_EQ(ia->second.q_xyzw, ib->second.q_xyzw);
+  }
+
+  const double with_camera = ate_m(a.poses, truth), lidar_only = ate_m(lio.poses, truth);
+  std::printf("tunnel seed 4, 30 s: ATE %.3f m with the visible camera, %.3f m lidar-inertial\n",
+              with_camera, lidar_only);
+  // Measured when written: 0.49 m against 4.96 m. The camera must at least quarter the error and
+  // keep it under a metre in 30 s, which the lidar alone cannot.
+  EXPECT_LT(with_camera, 1.0);
+  EXPECT_LT(with_camera, lidar_only / 4);
+  EXPECT_GT(lidar_only, 1.0);
+}
+
+}  // namespace cameras_estimate_replay_test
+}  // namespace posed::testing
