@@ -366,7 +366,15 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     }
   }
   if (!match.ok) ++figures_.scans_rejected;
-  if (match.ok && match.degenerate_directions > 0) ++figures_.scans_degenerate;
+  if (match.ok && match.degenerate_directions > 0) {
+    ++figures_.scans_degenerate;
+    last_degenerate_stamp_ = t;
+  }
+  // A weakly pinned direction is only suspect where the lidar has recently shown it is in a
+  // place it cannot pin (a roadway, a corridor): on an open street a scan's weakest direction
+  // is right, and the cameras' motion, scaled by depths with their own errors, is not better.
+  lidar_suspect_ = last_degenerate_stamp_ &&
+                   (t - *last_degenerate_stamp_).seconds() <= config_.aided_suspect_window_s;
 
   begin(LioStep::kWindow);
   if (window_.empty()) {
@@ -436,7 +444,7 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   }
   motions_.clear();
   if (aiding_ != nullptr) aiding_->relative_motions(window_, predicted, motions_);
-  if (lidar_factor && !motions_.empty()) reconcile(*lidar_factor);
+  if (lidar_factor && !motions_.empty() && lidar_suspect_) reconcile(*lidar_factor);
   const imu::ImuState initial = initial_value(predicted, pre, match);
   const std::uint64_t previous = window_.latest_id();
   window_.add(initial, pre, lidar_factor);

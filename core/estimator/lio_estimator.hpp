@@ -67,6 +67,8 @@ struct LioConfig {
   /// it (reconcile()) [1/m²], [sigma]
   double aided_trusted_information = 8e4;
   double aided_consistency_sigma = 3.0;
+  /// reconcile() only within this time after a scan with a degenerate direction [s]
+  double aided_suspect_window_s = 5.0;
   /// seed 001's adaptive pose selection of each state's initial value (pose_selection.hpp); off:
   /// the IMU prediction
   bool pose_selection = true;
@@ -186,8 +188,10 @@ class LioEstimator final : public FusionCore {
   std::uint64_t sequence_ = 0;
   LioStepProbe* probe_ = nullptr;
   WindowAiding* aiding_ = nullptr;
-  std::vector<RelativeMotion> motions_;  // this scan's, from the aiding
-  bool aided_degeneracy_ = false;        // the lidar's degeneracy is set for an active aiding
+  std::vector<RelativeMotion> motions_;            // this scan's, from the aiding
+  std::optional<HostTime> last_degenerate_stamp_;  // of the last scan with a degenerate direction
+  bool lidar_suspect_ = false;     // one was found within aided_suspect_window_s (reconcile())
+  bool aided_degeneracy_ = false;  // the lidar's degeneracy is set for an active aiding
   void begin(LioStep s) {
     if (probe_ != nullptr) probe_->begin(s);
   }

@@ -297,6 +297,11 @@ const Field kSchema[] = {
       0.5, 100, "",
       "where the scan and the cameras disagree by more than this, the scan says nothing along "
       "that direction (an aliased match, e.g. a roadway's uniform pipes)"),
+    F("estimator.camera_lidar_suspect_window_s", estimator.camera_lidar_suspect_window_s, "5", "s",
+      0, 3600, "",
+      "the scan is checked against the cameras only this long after a scan with a degenerate "
+      "direction: where the lidar has not shown it is lost (an open street) its weak directions "
+      "are right"),
     F("estimator.pose_selection", estimator.pose_selection, "true", "", 0, 0, "",
       "seed 001's adaptive pose selection: each state starts from the lidar, camera or fused "
       "odometry by the dynamic-threshold rule (false: the IMU prediction)"),

@@ -180,6 +180,7 @@ struct EstimatorSection {
   double camera_degenerate_information_scale = 0;       ///< with cameras in the estimate [-]
   double camera_lidar_trusted_constraints = 200;  ///< above: a scan's direction is not checked [1]
   double camera_lidar_consistency_sigma = 3;      ///< scan vs cameras disagreement allowed
+  double camera_lidar_suspect_window_s = 5;  ///< checked only this long after a degenerate scan [s]
 };
 
 /// One pipeline thread: SCHED_FIFO priority (0 = normal scheduling) and CPU (-1 = any).

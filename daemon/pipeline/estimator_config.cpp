@@ -57,6 +57,7 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
       e.camera_lidar_trusted_constraints /
       (l.lidar.matcher.residual_sigma_m * l.lidar.matcher.residual_sigma_m);
   l.aided_consistency_sigma = e.camera_lidar_consistency_sigma;
+  l.aided_suspect_window_s = e.camera_lidar_suspect_window_s;
   return l;
 }
 
