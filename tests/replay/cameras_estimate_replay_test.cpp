@@ -14,6 +14,7 @@
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/replay/recorded_poses.hpp"
 #include "tools/eval/umeyama.hpp"
 
 namespace posed::testing {
@@ -24,25 +25,6 @@ using namespace std::chrono_literals;
 namespace rec = drivers::recording;
 
 int test_domain() { return 1 + static_cast<int>((::getpid() + 37) % 99); }
-
-/// The messages of `topic` in a recording, decoded, by stamp [ns].
-std::map<std::int64_t, rec::ros2::StampedPose> read_poses(const std::string& path,
-                                                          const std::string& topic, bool odometry) {
-  rec::McapReader reader;
-  std::string error;
-  EXPECT_TRUE(reader.open(path, error)) << error;
-  std::map<std::int64_t, rec::ros2::StampedPose> out;
-  rec::McapMessage m;
-  while (reader.next(m)) {
-    if (m.channel->topic != topic) continue;
-    rec::ros2::StampedPose p;
-    const bool ok = odometry ? rec::ros2::decode_odometry(m.data, p)
-                             : rec::ros2::decode_pose_stamped(m.data, p);
-    EXPECT_TRUE(ok);
-    out[p.stamp.ns] = p;
-  }
-  return out;
-}
 
 Eigen::Vector3d xyz(const rec::ros2::StampedPose& p) {
   return {p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]};
@@ -81,7 +63,7 @@ Replay replay(TempDir& dir, const std::string& recording, const std::string& mod
        "--wait-subscribers", "0", "--record", dir.file(name + ".mcap")},
       {}, dir);
   EXPECT_EQ(posed.wait_for_exit(300s), 0) << posed.err();
-  return {read_poses(dir.file(name + ".mcap"), "/posed/pose", false), posed.out()};
+  return {recorded_poses(dir.file(name + ".mcap"), "/posed/pose", false), posed.out()};
 }
 
 TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
@@ -94,7 +76,7 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
         {}, dir);
     ASSERT_EQ(sim.wait_for_exit(300s), 0) << sim.err();
   }
-  const auto truth = read_poses(recording, "/posed/ground_truth", true);
+  const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   const Replay a = replay(dir, recording, "visible", "a");
   const Replay b = replay(dir, recording, "visible", "b");
   const Replay lio = replay(dir, recording, "off", "lio");

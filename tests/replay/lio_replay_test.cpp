@@ -16,6 +16,7 @@
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/replay/recorded_poses.hpp"
 
 namespace posed::testing {
 // Named rather than anonymous: test binaries build as unity batches, where another file's
@@ -26,25 +27,6 @@ using namespace std::chrono_literals;
 namespace rec = drivers::recording;
 
 int test_domain() { return 1 + static_cast<int>((::getpid() + 25) % 99); }
-
-/// The messages of `topic` in a recording, decoded, by stamp [ns].
-std::map<std::int64_t, rec::ros2::StampedPose> poses(const std::string& path,
-                                                     const std::string& topic, bool odometry) {
-  rec::McapReader reader;
-  std::string error;
-  EXPECT_TRUE(reader.open(path, error)) << error;
-  std::map<std::int64_t, rec::ros2::StampedPose> out;
-  rec::McapMessage m;
-  while (reader.next(m)) {
-    if (m.channel->topic != topic) continue;
-    rec::ros2::StampedPose p;
-    const bool ok = odometry ? rec::ros2::decode_odometry(m.data, p)
-                             : rec::ros2::decode_pose_stamped(m.data, p);
-    EXPECT_TRUE(ok);
-    out[p.stamp.ns] = p;
-  }
-  return out;
-}
 
 Eigen::Vector3d position(const rec::ros2::StampedPose& p) {
   return {p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]};
@@ -73,9 +55,9 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
     EXPECT_NE(posed.out().find("lidar-inertial"), std::string::npos) << posed.out();
     outputs.push_back(dir.file(name));
   }
-  const auto a = poses(outputs[0], "/posed/pose", false);
-  const auto b = poses(outputs[1], "/posed/pose", false);
-  const auto truth = poses(recording, "/posed/ground_truth", true);
+  const auto a = recorded_poses(outputs[0], "/posed/pose", false);
+  const auto b = recorded_poses(outputs[1], "/posed/pose", false);
+  const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   ASSERT_GT(a.size(), 120u);  // 10 Hz after the 2 s standing start
   ASSERT_EQ(a.size(), b.size());
   for (auto ia = a.begin(), ib = b.begin(); ia != a.end(); ++ia, ++ib) {
