@@ -52,6 +52,14 @@ int main(int argc, char** argv) noexcept try {
   app.add_flag("--max-speed", max_speed,
                "replay as fast as the pipeline goes; lossless and deterministic")
       ->needs(replay);
+  auto* live_stamps =
+      app.add_flag("--live-stamps", options.replay.live_stamps,
+                   "with --replay: at recorded timing, re-stamped onto this host's clock now, so "
+                   "the replay looks live to every DDS subscriber (stamp-to-receive latency as on "
+                   "the robot, with all four sensors) and the summary and status report posed's "
+                   "own latency; raw recordings only (an imported ROS 1 topic keeps its header "
+                   "stamps)")
+          ->needs(replay);
   app.add_flag("--loop", options.replay.loop, "replay the recording again and again")
       ->needs(replay);
   app.add_option("--start", options.replay.start_s, "skip this much of the recording [s]")
@@ -69,6 +77,12 @@ int main(int argc, char** argv) noexcept try {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--version", version, "print the version and exit");
   CLI11_PARSE(app, argc, argv);
+  if (live_stamps->count() > 0 && (max_speed || options.replay.rate != 1.0)) {
+    std::fprintf(stderr,
+                 "posed: --live-stamps replays at recorded timing: drop --max-speed and "
+                 "--rate\n");
+    return 2;
+  }
   if (max_speed) options.replay.rate = 0;
   options.replay.duration_s = options.duration_s;
 

@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -18,6 +19,7 @@
 #include "daemon/notify/stage_watchdog.hpp"
 #include "daemon/pipeline/camera_calibration.hpp"
 #include "daemon/pipeline/camera_stage.hpp"
+#include "daemon/pipeline/latency_histogram.hpp"
 #include "daemon/pipeline/pipeline.hpp"
 #include "daemon/pipeline/recording_tap.hpp"
 #include "daemon/pipeline/source_factory.hpp"
@@ -43,12 +45,14 @@ double yaw_deg(const Eigen::Quaterniond& q) {
   return std::atan2(x.y(), x.x()) * 180.0 / M_PI;
 }
 
-/// What the publisher thread has seen, for the summary (read by main after the threads end).
+/// What was published, for the summary (read by main after the threads end). Odometry is
+/// written by one thread (the IMU stage's, or the publisher's when it is not decoupled), poses
+/// and status by the publisher's.
 struct PublishTally {
-  std::uint64_t odom = 0;
+  std::atomic<std::uint64_t> odom{0};
   std::uint64_t pose = 0;
   std::uint64_t status = 0;
-  std::uint64_t failed = 0;
+  std::atomic<std::uint64_t> failed{0};
   std::optional<NavState> first;
   std::optional<NavState> last;
   double distance_m = 0;
@@ -87,6 +91,53 @@ bool save_map(const pipeline::Pipeline& pipe, const std::string& map_path, HostT
   line = buf;
   return true;
 }
+
+/// One topic's latency at its DDS write (rt/posed/status, the summary).
+struct TopicLatency {
+  const char* topic;
+  pipeline::LatencyHistogram receive_to_write;
+  pipeline::LatencyHistogram stamp_age;
+
+  /// Right after the write of a message made from `s`; `now` on the host clock.
+  void record(const NavState& s, HostTime now) {
+    if (s.received.ns != 0) receive_to_write.record(now - s.received);
+    stamp_age.record(now - s.stamp);
+  }
+  dds::TopicLatencyMessage message(bool live) const {
+    dds::TopicLatencyMessage m;
+    m.topic = topic;
+    m.count = stamp_age.count();
+    m.live = live;
+    if (!live) return m;
+    const pipeline::LatencySummary r = receive_to_write.summary(), a = stamp_age.summary();
+    m.receive_to_write_p50_ms = r.p50_ms;
+    m.receive_to_write_p99_ms = r.p99_ms;
+    m.receive_to_write_max_ms = r.max_ms;
+    m.stamp_age_p50_ms = a.p50_ms;
+    m.stamp_age_p99_ms = a.p99_ms;
+    m.stamp_age_max_ms = a.max_ms;
+    return m;
+  }
+  /// The summary's line: "rt/posed/odom  12000 written, receive->write p50 ... ms".
+  std::string line(bool live) const {
+    char buf[320];
+    const dds::TopicLatencyMessage m = message(live);
+    if (!live) {
+      std::snprintf(buf, sizeof buf,
+                    "%-14s %llu written; n/a (a replay's stamps are not this host's clock now: "
+                    "--live-stamps)",
+                    topic, static_cast<unsigned long long>(m.count));
+    } else {
+      std::snprintf(buf, sizeof buf,
+                    "%-14s %llu written; receive->write p50 %.3f, p99 %.3f, max %.3f ms; stamp "
+                    "age p50 %.3f, p99 %.3f, max %.3f ms",
+                    topic, static_cast<unsigned long long>(m.count), m.receive_to_write_p50_ms,
+                    m.receive_to_write_p99_ms, m.receive_to_write_max_ms, m.stamp_age_p50_ms,
+                    m.stamp_age_p99_ms, m.stamp_age_max_ms);
+    }
+    return buf;
+  }
+};
 
 }  // namespace
 
@@ -133,7 +184,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     pipeline::ReplaySources replay = pipeline::make_replay_sources(options.replay, error);
     // Replayed stamps are the recording's host clock; its wall offset keeps the DDS stamps (and
     // so the ground truth of a simulated run) in the recorded time base.
-    if (replay.have_host_to_wall) to_wall = replay.host_to_wall;
+    // With --live-stamps the stamps are this host's clock now, and so is the wall offset.
+    if (replay.have_host_to_wall && !options.replay.live_stamps) to_wall = replay.host_to_wall;
     built = std::move(replay.built);
     replay_streams = replay.streams;
     if (options.replay.recorded_config) {
@@ -170,36 +222,57 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   }
 
   PublishTally tally;
+  // Stamps are this host's clock now live and in a replay with --live-stamps; otherwise a
+  // recording's, and how late a message is cannot be told from them.
+  const bool live_clock = !replaying || options.replay.live_stamps;
+  TopicLatency odom_latency{"rt/posed/odom", {}, {}};
+  TopicLatency pose_latency{"rt/posed/pose", {}, {}};
   const Duration pose_period = Duration::from_seconds(1.0 / config.publish.pose_rate_hz);
-  std::uint64_t state_index = 0;
-  pipeline::PipelineOutputs outputs;
-  outputs.keep_map = !options.map_path.empty();
-  outputs.on_state = [&](const NavState& s) {
+  std::uint64_t odom_index = 0;
+  // IMU-rate propagation on rt/posed/odom: on the IMU stage's thread when odometry is kept apart
+  // from the back end, else on the publisher's.
+  const auto publish_odom = [&](const NavState& s) {
+    if (tally.last) tally.distance_m += (s.p_map_base_m - tally.last->p_map_base_m).norm();
+    if (!tally.first) tally.first = s;
+    tally.last = s;
+    if (odom_index++ % static_cast<std::uint64_t>(config.publish.odom_decimation) != 0) return;
     const WallTime stamp = to_wall(s.stamp);
-    // Optimised states (one per scan) go on rt/posed/pose; IMU propagation on rt/posed/odom. An
-    // estimator without optimised states (strapdown) has its propagation decimated onto pose.
-    if (s.optimised) tally.have_optimised = true;
-    if (!s.optimised) {
-      if (tally.last) tally.distance_m += (s.p_map_base_m - tally.last->p_map_base_m).norm();
-      if (!tally.first) tally.first = s;
-      tally.last = s;
-      if (state_index++ % static_cast<std::uint64_t>(config.publish.odom_decimation) == 0) {
-        dds::OdomMessage odom;
-        odom.stamp = stamp;
-        odom.p_map_base_m = s.p_map_base_m;
-        odom.q_map_base = s.q_map_base;
-        odom.v_base_mps = s.q_map_base.conjugate() * s.v_map_mps;
-        odom.w_base_radps = s.w_base_radps;
-        odom.pose_covariance = to_row_major(s.pose_covariance);
-        odom.twist_covariance = to_row_major(s.twist_covariance);
-        if (!publisher) {
-          // offline run: nothing to publish
-        } else if (publisher->publish_odom(odom))
-          ++tally.odom;
-        else
-          ++tally.failed;
+    if (publisher) {
+      dds::OdomMessage odom;
+      odom.stamp = stamp;
+      odom.p_map_base_m = s.p_map_base_m;
+      odom.q_map_base = s.q_map_base;
+      odom.v_base_mps = s.q_map_base.conjugate() * s.v_map_mps;
+      odom.w_base_radps = s.w_base_radps;
+      odom.pose_covariance = to_row_major(s.pose_covariance);
+      odom.twist_covariance = to_row_major(s.twist_covariance);
+      if (publisher->publish_odom(odom)) {
+        odom_latency.record(s, drivers::host_now());
+        tally.odom.fetch_add(1, std::memory_order_relaxed);
+      } else {
+        tally.failed.fetch_add(1, std::memory_order_relaxed);
       }
     }
+    if (recorder) {
+      // After the write: the recording must never delay the odometry.
+      const Eigen::Quaterniond& q = s.q_map_base;
+      const Eigen::Vector3d v_base = s.q_map_base.conjugate() * s.v_map_mps;
+      recorder->write_odometry("/posed/odom", stamp, config.dds.map_frame, config.dds.base_frame,
+                               {s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z()},
+                               {q.x(), q.y(), q.z(), q.w()}, {v_base.x(), v_base.y(), v_base.z()},
+                               {s.w_base_radps.x(), s.w_base_radps.y(), s.w_base_radps.z()});
+    }
+  };
+  pipeline::PipelineOutputs outputs;
+  outputs.keep_map = !options.map_path.empty();
+  outputs.on_odom = publish_odom;
+  outputs.on_state = [&](const NavState& s) {
+    const WallTime stamp = to_wall(s.stamp);
+    // Optimised states (one per scan) go on rt/posed/pose; IMU propagation (when the back end
+    // makes it) on rt/posed/odom. An estimator without optimised states (strapdown) has its
+    // propagation decimated onto pose.
+    if (s.optimised) tally.have_optimised = true;
+    if (!s.optimised) publish_odom(s);
     const bool pose_now =
         s.optimised || (!tally.have_optimised && s.stamp >= tally.next_pose_stamp);
     if (pose_now) {
@@ -210,10 +283,12 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
       pose.q_map_base = s.q_map_base;
       if (!publisher) {
         // offline run: nothing to publish
-      } else if (publisher->publish_pose(pose))
+      } else if (publisher->publish_pose(pose)) {
+        pose_latency.record(s, drivers::host_now());
         ++tally.pose;
-      else
-        ++tally.failed;
+      } else {
+        tally.failed.fetch_add(1, std::memory_order_relaxed);
+      }
       if (recorder) {
         const Eigen::Quaterniond& q = s.q_map_base;
         recorder->write_pose("/posed/pose", stamp, config.dds.map_frame,
@@ -265,6 +340,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
                      f.selection.visual_inertial, f.selection.imu_only,
                      f.selection.last_threshold_m};
     msg.uptime_s = (st.stamp - started).seconds();
+    msg.latency = {odom_latency.message(live_clock), pose_latency.message(live_clock)};
     std::string line = std::string(to_string(st.mode));
     for (const auto& s : st.streams) {
       dds::StreamStatusMessage m;
@@ -288,15 +364,16 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     }
     char odom_part[64];
     std::snprintf(odom_part, sizeof odom_part, "; %llu odom published",
-                  static_cast<unsigned long long>(tally.odom));
+                  static_cast<unsigned long long>(tally.odom.load()));
     line += odom_part;
     msg.summary = line;
     if (!publisher) {
       // offline run: nothing to publish
-    } else if (publisher->publish_status(msg))
+    } else if (publisher->publish_status(msg)) {
       ++tally.status;
-    else
-      ++tally.failed;
+    } else {
+      tally.failed.fetch_add(1, std::memory_order_relaxed);
+    }
     std::lock_guard lock(status_line_mutex);
     status_line = line;
   };
@@ -483,10 +560,18 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     std::printf("  published           nothing (offline run, no DDS)\n");
   else
     std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
-                static_cast<unsigned long long>(tally.odom),
+                static_cast<unsigned long long>(tally.odom.load()),
                 static_cast<unsigned long long>(tally.pose),
                 static_cast<unsigned long long>(tally.status), config.dds.domain_id,
-                tally.failed ? " (some writes failed)" : "");
+                tally.failed.load() ? " (some writes failed)" : "");
+  if (publisher) {
+    std::printf("  latency             %s\n", odom_latency.line(live_clock).c_str());
+    std::printf("                      %s\n", pose_latency.line(live_clock).c_str());
+    std::printf("  odometry            %s\n",
+                pipe.odometry_decoupled()
+                    ? "propagated on the IMU thread from the newest optimised state"
+                    : "propagated by the back end after each measurement");
+  }
   if (recorder) {
     const auto rc = recorder->counters();
     std::printf("  recorded            %llu messages to %s (%.1f MB, %llu dropped)\n",

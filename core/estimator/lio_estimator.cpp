@@ -85,6 +85,9 @@ NavState LioEstimator::to_nav_state(const imu::ImuState& s, const Eigen::Vector3
   out.twist_covariance.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * sg * sg * 200.0;
   out.mode = mode_;
   out.optimised = optimised;
+  out.anchor = optimised;
+  out.gyro_bias_radps = s.bias.gyro_radps;
+  out.accel_bias_mps2 = s.bias.accel_mps2;
   out.sequence = 0;
   return out;
 }
@@ -135,6 +138,9 @@ void LioEstimator::add_imu(const ImuSample& sample, std::vector<NavState>& state
     NavState s = to_nav_state(
         propagated_, sample.angular_velocity_radps - propagated_.bias.gyro_radps, false, cov);
     s.sequence = ++sequence_;
+    // The first state after the alignment is where odometry kept apart from the back end starts.
+    s.anchor = !first_state_emitted_;
+    first_state_emitted_ = true;
     states.push_back(s);
   }
   release_scans(states);

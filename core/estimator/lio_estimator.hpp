@@ -181,6 +181,7 @@ class LioEstimator final : public FusionCore {
   /// IMU propagation for odom: from the anchor through every sample since
   imu::ImuState propagated_;
   std::optional<ImuSample> propagated_last_;
+  bool first_state_emitted_ = false;
   /// the last two matched lidar poses (stamp, T_map_lidar), oldest first
   std::array<std::optional<std::pair<HostTime, Eigen::Isometry3d>>, 2> matched_;
   EstimatorMode mode_ = EstimatorMode::kAligning;

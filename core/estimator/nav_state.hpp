@@ -52,6 +52,15 @@ struct NavState {
   bool optimised = false;
   /// increments with every state
   std::uint64_t sequence = 0;
+  /// IMU propagation may start from this state (daemon/pipeline/odometry_path.hpp): every
+  /// optimised state, and the first state after the alignment
+  bool anchor = false;
+  /// the biases the state was estimated with [rad/s], [m/s^2]
+  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
+  /// host receive time of the newest sample that went into the state (the Source's receive
+  /// stamp; set by the pipeline, unset by the cores), for latency figures
+  HostTime received;
 };
 
 }  // namespace posed

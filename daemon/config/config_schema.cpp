@@ -27,6 +27,12 @@ const Field kSchema[] = {
 
     F("publish.odom_decimation", publish.odom_decimation, "1", "", 1, 1000, "",
       "publish every Nth propagated state on rt/posed/odom"),
+    F("publish.odom_decoupled", publish.odom_decoupled, "true", "", 0, 0, "",
+      "with a lidar: rt/posed/odom propagated on the IMU thread from the newest optimised state, "
+      "never waiting for scan matching, cameras or the window; false: by the back end"),
+    F("publish.odom_blend_s", publish.odom_blend_s, "0.1", "s", 0, 2, "",
+      "a correction to rt/posed/odom (a new optimised state) is spread over this long; 0 applies "
+      "it at once"),
     F("publish.pose_rate_hz", publish.pose_rate_hz, "10", "Hz", 0.1, 1000, "",
       "rt/posed/pose rate while the estimator is strapdown"),
     F("publish.status_rate_hz", publish.status_rate_hz, "1", "Hz", 0.1, 100, "",

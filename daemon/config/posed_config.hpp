@@ -26,7 +26,11 @@ struct DdsSection {
 };
 
 struct PublishSection {
-  int odom_decimation = 1;      ///< publish every Nth propagated state on rt/posed/odom
+  int odom_decimation = 1;  ///< publish every Nth propagated state on rt/posed/odom
+  /// odometry propagated on the IMU stage's thread from the newest optimised state, never
+  /// waiting for scan matching, cameras or the window (false: by the back end, late by them)
+  bool odom_decoupled = true;
+  double odom_blend_s = 0.1;    ///< a correction to odometry is spread over this long [s]
   double pose_rate_hz = 10.0;   ///< rt/posed/pose rate while the estimator is strapdown [Hz]
   double status_rate_hz = 1.0;  ///< rt/posed/status rate [Hz]
 };

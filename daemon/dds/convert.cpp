@@ -125,6 +125,19 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
     d.clock_state = c_str(s.clock_state);
     d.health = c_str(s.health);
   }
+  for (std::size_t i = 0; i < msg.latency.size(); ++i) {
+    const TopicLatencyMessage& l = msg.latency[i];
+    posed_msgs_msg_dds__TopicLatency_& d = out.latency[i];
+    d.topic = c_str(l.topic);
+    d.count = l.count;
+    d.live = l.live;
+    d.receive_to_write_p50_ms = l.receive_to_write_p50_ms;
+    d.receive_to_write_p99_ms = l.receive_to_write_p99_ms;
+    d.receive_to_write_max_ms = l.receive_to_write_max_ms;
+    d.stamp_age_p50_ms = l.stamp_age_p50_ms;
+    d.stamp_age_p99_ms = l.stamp_age_p99_ms;
+    d.stamp_age_max_ms = l.stamp_age_max_ms;
+  }
   out.streams._buffer = streams.data();
   out.streams._length = static_cast<std::uint32_t>(msg.streams.size());
   out.streams._maximum = static_cast<std::uint32_t>(streams.size());
@@ -222,6 +235,19 @@ StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
     d.clock_state = to_string(s.clock_state);
     d.health = to_string(s.health);
     msg.streams.push_back(std::move(d));
+  }
+  for (std::size_t i = 0; i < msg.latency.size(); ++i) {
+    const posed_msgs_msg_dds__TopicLatency_& l = in.latency[i];
+    TopicLatencyMessage& d = msg.latency[i];
+    d.topic = to_string(l.topic);
+    d.count = l.count;
+    d.live = l.live;
+    d.receive_to_write_p50_ms = l.receive_to_write_p50_ms;
+    d.receive_to_write_p99_ms = l.receive_to_write_p99_ms;
+    d.receive_to_write_max_ms = l.receive_to_write_max_ms;
+    d.stamp_age_p50_ms = l.stamp_age_p50_ms;
+    d.stamp_age_p99_ms = l.stamp_age_p99_ms;
+    d.stamp_age_max_ms = l.stamp_age_max_ms;
   }
   return msg;
 }

@@ -156,6 +156,18 @@ struct PoseSelectionStatusMessage {
   double threshold_m = 0;                   ///< [m]
 };
 
+/// How late one published topic is (posed_msgs/TopicLatency), since start.
+struct TopicLatencyMessage {
+  std::string topic;  ///< e.g. "rt/posed/odom"; empty: unused slot
+  std::uint64_t count = 0;
+  /// stamps on this host's clock now; false: a replay's recorded stamps, all figures zero
+  bool live = false;
+  /// newest sample's host receive -> DDS write [ms]
+  double receive_to_write_p50_ms = 0, receive_to_write_p99_ms = 0, receive_to_write_max_ms = 0;
+  /// message stamp -> DDS write [ms]
+  double stamp_age_p50_ms = 0, stamp_age_p99_ms = 0, stamp_age_max_ms = 0;
+};
+
 /// posed_msgs/Status: published at 1 Hz.
 struct StatusMessage {
   /// time of the report (wall clock, UNIX epoch) [ns]
@@ -177,6 +189,8 @@ struct StatusMessage {
   std::string summary;
   /// one entry per input stream
   std::vector<StreamStatusMessage> streams;
+  /// rt/posed/odom, rt/posed/pose
+  std::array<TopicLatencyMessage, 2> latency{};
 };
 
 /// Where and how posed talks DDS (the `dds:` section of the daemon config).

@@ -97,7 +97,7 @@ void CameraStage::handle_frame(const drivers::RawChunk& chunk, std::span<const s
   }
   image.stamp = stamp;
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
-  const PushResult r = queue_.push(ImageItem{std::move(image), false});
+  const PushResult r = queue_.push(ImageItem{std::move(image), false, chunk.host_receive});
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   consumer_.signal();
 }
@@ -129,7 +129,7 @@ void CameraStage::run() {
     if (++frames % 16 == 0) counters_.publish_clock(clock_.status());
   }
   counters_.publish_clock(clock_.status());
-  queue_.push(ImageItem{{}, true});
+  queue_.push(ImageItem{{}, true, {}});
   consumer_.signal();
 }
 

@@ -1,5 +1,6 @@
 #include "daemon/pipeline/fusion_stage.hpp"
 
+#include <algorithm>
 #include <optional>
 
 #include "daemon/pipeline/thread_policy.hpp"
@@ -49,7 +50,7 @@ class FusionStage::Lane {
 FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<FusionCore> core,
                          FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
                          Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
-                         FusionCounters& counters)
+                         FusionCounters& counters, OdometryHandover odometry)
     : config_(config),
       core_(std::move(core)),
       inputs_(inputs),
@@ -58,16 +59,35 @@ FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<Fusi
       inputs_ready_(inputs_ready),
       publisher_(publisher),
       heartbeat_(heartbeat),
-      counters_(counters) {
+      counters_(counters),
+      odometry_(odometry) {
   // A scan can release a burst of states (the IMU samples it waited for); no allocation later.
   produced_.reserve(4096);
+  outgoing_.reserve(4096);
+}
+
+void FusionStage::route_states() {
+  for (NavState& state : produced_) {
+    state.received = newest_received_;
+    if (odometry_.anchors == nullptr) {
+      outgoing_.push_back(state);
+      continue;
+    }
+    if (state.anchor) {
+      odometry_.anchors->push(AnchorItem{state, imu_consumed_});
+    }
+    // The core's own propagation is replaced by the odometry path's.
+    if (state.optimised) outgoing_.push_back(state);
+  }
+  counters_.states.fetch_add(produced_.size(), std::memory_order_relaxed);
+  produced_.clear();
 }
 
 void FusionStage::emit_states() {
-  if (produced_.empty()) return;
-  for (const NavState& state : produced_) states_.push(StateItem{state, false});
-  counters_.states.fetch_add(produced_.size(), std::memory_order_relaxed);
-  produced_.clear();
+  route_states();
+  if (outgoing_.empty()) return;
+  for (const NavState& state : outgoing_) states_.push(StateItem{state, false});
+  outgoing_.clear();
   publisher_.signal();
 }
 
@@ -116,21 +136,40 @@ void FusionStage::run() {
     for (Next n = next(); n != Next::kNone; n = next()) {
       heartbeat_.beat();  // a backlog can take a while; the watchdog must see the stage alive
       switch (n) {
-        case Next::kImu:
-          core_->add_imu(imu.take().sample, produced_);
+        case Next::kImu: {
+          ImuItem item = imu.take();
+          newest_received_ = std::max(newest_received_, item.received);
+          core_->add_imu(item.sample, produced_);
+          imu_consumed_ = item.sample.stamp;
+          if (odometry_.progress != nullptr) {
+            // The anchors this sample released go out before the progress that lets the
+            // odometry look for them.
+            route_states();
+            odometry_.progress->consumed_imu(imu_consumed_);
+          }
           break;
-        case Next::kScan:
-          core_->add_scan(scans.take().scan, produced_);
+        }
+        case Next::kScan: {
+          ScanItem item = scans.take();
+          newest_received_ = std::max(newest_received_, item.received);
+          core_->add_scan(std::move(item.scan), produced_);
           counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);
           break;
-        case Next::kVisible:
-          core_->add_image(CameraStream::kVisible, visible.take().image, produced_);
+        }
+        case Next::kVisible: {
+          ImageItem item = visible.take();
+          newest_received_ = std::max(newest_received_, item.received);
+          core_->add_image(CameraStream::kVisible, std::move(item.image), produced_);
           counters_.frames_fused[0].fetch_add(1, std::memory_order_relaxed);
           break;
-        case Next::kThermal:
-          core_->add_image(CameraStream::kThermal, thermal.take().image, produced_);
+        }
+        case Next::kThermal: {
+          ImageItem item = thermal.take();
+          newest_received_ = std::max(newest_received_, item.received);
+          core_->add_image(CameraStream::kThermal, std::move(item.image), produced_);
           counters_.frames_fused[1].fetch_add(1, std::memory_order_relaxed);
           break;
+        }
         case Next::kNone:
           break;
       }
@@ -138,7 +177,7 @@ void FusionStage::run() {
       handed = true;
       ++handed_since_figures;
       // Bounded latency for the publisher even while a backlog drains.
-      if (produced_.size() >= 64) emit_states();
+      if (produced_.size() + outgoing_.size() >= 64) emit_states();
     }
     emit_states();
     if (handed_since_figures > 0) {
@@ -148,6 +187,7 @@ void FusionStage::run() {
     if (!handed) inputs_ready_.wait_for(kStageWaitTimeout);
   }
   counters_.publish_figures(core_->figures());
+  if (odometry_.progress != nullptr) odometry_.progress->ended();
   states_.push(StateItem{{}, true});
   publisher_.signal();
 }

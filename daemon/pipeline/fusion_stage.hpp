@@ -12,6 +12,7 @@
 // over whatever has arrived, oldest first, and the core's MeasurementGate orders the rest.
 
 #include <atomic>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "core/estimator/fusion_core.hpp"
 #include "core/spsc_queue.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/odometry_path.hpp"
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 
@@ -46,6 +48,13 @@ struct FusionCounters {
   FusionFigures figures_;
 };
 
+/// Where the back end's anchors go when odometry runs apart from it (OdometryPath); with it, the
+/// core's own IMU propagation (late by a scan match) is not published.
+struct OdometryHandover {
+  SpscQueue<AnchorItem>* anchors = nullptr;
+  BackEndProgress* progress = nullptr;
+};
+
 struct FusionInputs {
   SpscQueue<ImuItem>* imu = nullptr;        ///< required
   SpscQueue<ScanItem>* scans = nullptr;     ///< null without a lidar
@@ -58,7 +67,7 @@ class FusionStage {
   FusionStage(const config::PosedConfig& config, std::unique_ptr<FusionCore> core,
               FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
               Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
-              FusionCounters& counters);
+              FusionCounters& counters, OdometryHandover odometry = {});
   /// Runs until every input stream has ended, then forwards end-of-stream to the publisher.
   void run();
   const FusionCore& core() const { return *core_; }
@@ -68,6 +77,8 @@ class FusionStage {
   class Lane;
   /// Hands the core every measurement the merge rule releases now; true if it handed any.
   bool dispatch_ready();
+  /// Routes the states the core produced: to the publisher and, as anchors, to the odometry.
+  void route_states();
   void emit_states();
 
   const config::PosedConfig& config_;
@@ -79,7 +90,14 @@ class FusionStage {
   Wakeup& publisher_;
   Heartbeat& heartbeat_;
   FusionCounters& counters_;
+  OdometryHandover odometry_;
   std::vector<NavState> produced_;
+  /// states for the publisher, routed from produced_
+  std::vector<NavState> outgoing_;
+  /// the newest receive stamp of everything handed to the core (NavState::received)
+  HostTime newest_received_;
+  /// the newest IMU stamp handed to the core (AnchorItem::released_at)
+  HostTime imu_consumed_ = HostTime::from_ns(std::numeric_limits<std::int64_t>::min());
 };
 
 }  // namespace posed::pipeline

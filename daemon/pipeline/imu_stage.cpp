@@ -47,10 +47,15 @@ void ImuStage::on_a9_frame(const a9::A9Frame& frame, HostTime arrival) {
 }
 
 void ImuStage::push(const ImuSample& sample) {
-  const PushResult r = queue_.push(ImuItem{sample, false});
+  const PushResult r = queue_.push(ImuItem{sample, false, chunk_received_});
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
   pushed_ = true;
+  if (odometry_ != nullptr) {
+    // The back end gets the sample first: a deterministic replay's odometry waits for it.
+    consumer_.signal();
+    odometry_->on_imu(sample, chunk_received_, heartbeat_);
+  }
 }
 
 // Frames the decoder rejected since the last look (CRC, truncation, unknown kind).
@@ -76,6 +81,7 @@ void ImuStage::run() {
   SourceReader reader("imu", source_, heartbeat_, counters_);
   const auto on_frame = [&](const a9::A9Frame& frame) { on_a9_frame(frame, chunk.host_receive); };
   while (reader.next(chunk)) {
+    chunk_received_ = chunk.host_receive;
     const std::string_view format = reader.wire_format(chunk);
     if (format == drivers::wire::kRos1Imu) {
       on_ros1_imu(chunk);
@@ -103,7 +109,7 @@ void ImuStage::run() {
   count_malformed();
   publish_progress();
   counters_.publish_clock(clock_.status());
-  queue_.push(ImuItem{{}, true});
+  queue_.push(ImuItem{{}, true, {}});
   consumer_.signal();
 }
 

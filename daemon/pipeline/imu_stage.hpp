@@ -7,6 +7,7 @@
 #include "core/spsc_queue.hpp"
 #include "core/sync/clock_sync.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/odometry_path.hpp"
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 #include "drivers/common/source.hpp"
@@ -19,6 +20,8 @@ class ImuStage {
  public:
   ImuStage(const config::PosedConfig& config, drivers::Source& source, SpscQueue<ImuItem>& queue,
            Wakeup& consumer, Heartbeat& heartbeat, StreamCounters& counters);
+  /// Optional: odometry from every sample on this thread, right after it went to the queue.
+  void set_odometry(OdometryPath* odometry) { odometry_ = odometry; }
   /// Runs until the Source ends (end of recording, or stopped), then forwards end-of-stream.
   void run();
 
@@ -49,6 +52,9 @@ class ImuStage {
   ClockSync clock_;
   std::uint64_t malformed_seen_ = 0;
   bool pushed_ = false;
+  OdometryPath* odometry_ = nullptr;
+  /// the Source's receive stamp of the chunk being decoded
+  HostTime chunk_received_;
 };
 
 }  // namespace posed::pipeline

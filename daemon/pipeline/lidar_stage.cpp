@@ -50,7 +50,7 @@ LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration 
 void LidarStage::push_scan(LidarScan&& scan) {
   scan_counters_.scans.fetch_add(1, std::memory_order_relaxed);
   scan_counters_.points.fetch_add(scan.point_count, std::memory_order_relaxed);
-  const PushResult r = queue_.push(ScanItem{std::move(scan), false});
+  const PushResult r = queue_.push(ScanItem{std::move(scan), false, chunk_received_});
   if (r == PushResult::kRejectedFull || r == PushResult::kRejectedTimeout ||
       r == PushResult::kPushedDropped) {
     counters_.dropped.fetch_add(1, std::memory_order_relaxed);
@@ -90,6 +90,7 @@ void LidarStage::run() {
   drivers::RawChunk chunk;
   SourceReader reader("lidar", source_, heartbeat_, counters_);
   while (reader.next(chunk)) {
+    chunk_received_ = chunk.host_receive;
     const std::string_view format = reader.wire_format(chunk);
     if (format == drivers::wire::kVelodyneData) {
       handle_data(chunk);
@@ -104,7 +105,7 @@ void LidarStage::run() {
   builder_.flush();
   forward_scans();
   counters_.publish_clock(cloud_decoder_ ? cloud_clock_ : builder_.clock().status());
-  queue_.push(ScanItem{{}, true});
+  queue_.push(ScanItem{{}, true, {}});
   consumer_.signal();
 }
 

@@ -65,6 +65,8 @@ class LidarStage {
   bool reported_cloud_layout_ = false;
   drivers::velodyne::AssembledScan assembled_;
   bool reported_pps_ = false;
+  /// the Source's receive stamp of the chunk being handled (a scan's is its last packet's)
+  HostTime chunk_received_;
 };
 
 }  // namespace posed::pipeline

@@ -180,11 +180,31 @@ bool Pipeline::start(std::string& error) {
       make_core(config_, sources_.lidar != nullptr, outputs_.keep_map, lio);
   core = with_cameras(std::move(core), lio, config_, sources_.visible != nullptr,
                       sources_.thermal != nullptr, in_stamp_order, outputs_, camera_core_);
+  // Odometry apart from the back end needs a back end with optimised states to anchor on (the
+  // lidar-inertial one); IMU-only dead reckoning is itself the cheap propagation.
+  OdometryHandover handover;
+  if (config_.publish.odom_decoupled && lio != nullptr && outputs_.on_odom) {
+    const estimator::LioConfig lio_settings = lio_config(config_);
+    estimator::OdometryPropagatorConfig odometry;
+    odometry.gravity_mps2 = lio_settings.gravity_mps2;
+    odometry.accel_noise_density = lio_settings.noise.accel_noise_density;
+    odometry.gyro_noise_density = lio_settings.noise.gyro_noise_density;
+    odometry.blend_s = config_.publish.odom_blend_s;
+    anchor_queue_ = std::make_unique<SpscQueue<AnchorItem>>(256, queue_policy(sources_.imu.get()),
+                                                            block_timeout(sources_.imu.get()));
+    back_end_progress_ = std::make_unique<BackEndProgress>();
+    // Max-speed replays wait for the back end so odometry is a function of the data alone.
+    const bool deterministic = in_stamp_order && !sources_.paced;
+    odometry_ = std::make_unique<OdometryPath>(odometry, *anchor_queue_, *back_end_progress_,
+                                               deterministic, outputs_.on_odom);
+    imu_stage_->set_odometry(odometry_.get());
+    handover = OdometryHandover{anchor_queue_.get(), back_end_progress_.get()};
+  }
   fusion_stage_ = std::make_unique<FusionStage>(
       config_, std::move(core),
       FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get()},
       in_stamp_order, state_queue_, fusion_ready_, state_ready_, *heartbeats_[stage++],
-      *fusion_counters_);
+      *fusion_counters_, handover);
   publisher_stage_ = std::make_unique<PublisherStage>(
       config_, state_queue_, state_ready_, *heartbeats_[stage++], outputs_.on_state,
       outputs_.on_status, [this] { return status(); });

@@ -24,6 +24,7 @@
 #include "core/spsc_queue.hpp"
 #include "core/time.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/odometry_path.hpp"
 #include "daemon/pipeline/pipeline_status.hpp"
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
@@ -58,6 +59,9 @@ struct PipelineSources {
   std::string lidar_calibration_text;
   /// where that text came from, for messages
   std::string lidar_calibration_name;
+  /// recordings replayed at recorded timing (or N times it), not as fast as they go: the
+  /// odometry then runs as it would live rather than waiting for the back end
+  bool paced = false;
 
   /// The camera Source of a stream (null when absent).
   std::unique_ptr<drivers::Source>& camera(CameraStream s) {
@@ -81,8 +85,12 @@ struct PipelineSources {
 
 /// Callbacks run on the publisher thread.
 struct PipelineOutputs {
-  /// every propagated state (the daemon publishes rt/posed/odom and, decimated, rt/posed/pose)
+  /// every state (the daemon publishes propagation on rt/posed/odom and optimised states, or
+  /// decimated propagation, on rt/posed/pose); without the odometry below, the propagation too
   std::function<void(const NavState&)> on_state;
+  /// IMU-rate odometry kept apart from the back end (publish.odom_decoupled, with a lidar),
+  /// called on the IMU stage's thread; null: the back end's own propagation goes to on_state
+  std::function<void(const NavState&)> on_odom;
   /// at publish.status_rate_hz, and once more at the end of the stream
   std::function<void(const PipelineStatus&)> on_status;
   /// keep a whole-run map for export_map() (posed --save-map); costs memory as the area grows
@@ -123,6 +131,8 @@ class Pipeline {
   std::vector<StageBeat> stage_heartbeats() const;
   /// A snapshot, safe from any thread.
   PipelineStatus status() const;
+  /// True when odometry runs apart from the back end (on_odom gets it; valid after start()).
+  bool odometry_decoupled() const { return odometry_ != nullptr; }
   /// The fusion core's one-line description (valid after start()).
   std::string estimator_description() const;
   /// The fusion core's map and keyframes (call after join(); empty without a lidar or keep_map).
@@ -160,6 +170,10 @@ class Pipeline {
   /// the fusion core when it has cameras (owned by fusion_stage_)
   const fusion::CameraAidedCore* camera_core_ = nullptr;
   std::unique_ptr<PublisherStage> publisher_stage_;
+  /// odometry apart from the back end: its anchors, the back end's progress, the path itself
+  std::unique_ptr<SpscQueue<AnchorItem>> anchor_queue_;
+  std::unique_ptr<BackEndProgress> back_end_progress_;
+  std::unique_ptr<OdometryPath> odometry_;
   bool started_ = false;
   std::atomic<std::size_t> finished_stages_{0};
   std::vector<std::thread> threads_;

@@ -82,6 +82,8 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     return out;
   }
 
+  const auto timeline =
+      options.live_stamps ? std::make_shared<recording::ReplayTimeline>() : nullptr;
   const auto make = [&](const std::string& stream) {
     recording::McapReplayConfig c;
     c.path = options.path;
@@ -91,9 +93,11 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     c.start_offset = Duration::from_seconds(options.start_s);
     c.duration = Duration::from_seconds(options.duration_s);
     c.loop = options.loop;
+    c.live_timeline = timeline;
     return std::make_unique<recording::McapReplaySource>(std::move(c));
   };
   out.built.sources.imu = make("imu");
+  out.built.sources.paced = options.rate > 0;
   if (streams.count("lidar")) {
     out.built.sources.lidar = make("lidar");
     if (options.recorded_config) {

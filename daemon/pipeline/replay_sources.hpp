@@ -19,6 +19,9 @@ struct ReplayOptions {
   /// replay only this much of it; 0 = to the end [s]
   double duration_s = 0;
   bool loop = false;
+  /// at recorded timing, re-stamped onto the host clock now (ReplayTimeline): the replay looks
+  /// live to ClockSync, the estimator and DDS subscribers (rate must be 1)
+  bool live_stamps = false;
   /// replaying with the configuration the recording was made with (--recorded-config): the lidar
   /// packets are decoded with the calibration recorded beside them, not lidar.calibration's file
   bool recorded_config = false;

@@ -26,17 +26,22 @@ inline constexpr auto kStageWaitTimeout = std::chrono::milliseconds(50);
 /// How long a Source read waits before the stage heartbeats again.
 inline const Duration kStageReadTimeout = Duration::from_ms(100);
 
+// `received`: the Source's receive stamp of the newest chunk that went into the measurement (the
+// scan's last packet), for the latency figures (NavState::received).
 struct ImuItem {
   ImuSample sample;
   bool end_of_stream = false;
+  HostTime received;
 };
 struct ScanItem {
   LidarScan scan;
   bool end_of_stream = false;
+  HostTime received;
 };
 struct ImageItem {
   Image image;
   bool end_of_stream = false;
+  HostTime received;
 };
 struct StateItem {
   NavState state;

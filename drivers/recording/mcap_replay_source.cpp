@@ -126,7 +126,21 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
       return ReadStatus::kEndOfStream;
     }
   }
-  if (config_.rate > 0) {
+  std::int64_t receive_ns = pending_log_ns_;
+  if (config_.live_timeline) {
+    const Duration shift = config_.live_timeline->shift(pending_log_ns_, host_now());
+    receive_ns = pending_log_ns_ + shift.ns;
+    const HostTime due = HostTime::from_ns(receive_ns);
+    const HostTime now = host_now();
+    if (due > now) {
+      const Duration wait = std::min(due - now, timeout);
+      std::unique_lock lock(wait_mutex_);
+      wait_cv_.wait_for(lock, std::chrono::nanoseconds(std::max<std::int64_t>(0, wait.ns)),
+                        [&] { return stop_.load(std::memory_order_relaxed); });
+      if (stop_.load(std::memory_order_relaxed)) return ReadStatus::kEndOfStream;
+      if (host_now() < due) return ReadStatus::kTimeout;
+    }
+  } else if (config_.rate > 0) {
     if (!paced_) {
       paced_ = true;
       anchor_host_ = host_now();
@@ -146,7 +160,7 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
     }
   }
   chunk.bytes = pending_.data;
-  chunk.host_receive = HostTime::from_ns(pending_log_ns_);
+  chunk.host_receive = HostTime::from_ns(receive_ns);
   {
     std::lock_guard lock(info_mutex_);
     chunk.channel = channels_[pending_.channel->id].source_channel;

@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -23,6 +24,29 @@
 #include "drivers/recording/mcap_reader.hpp"
 
 namespace posed::drivers::recording {
+
+/// One time base for the Sources of one replay (`posed --replay --live-stamps`): the first
+/// message any of them delivers fixes the shift from the recording's log time to the host clock
+/// now; every stream is then paced at recorded timing against it and stamped with log time +
+/// shift as its receive time, so the replay looks live to everything downstream (ClockSync, the
+/// estimator, DDS subscribers measuring latency) with the streams as far apart as recorded.
+class ReplayTimeline {
+ public:
+  /// host receive = log time + shift(); the first call fixes it from `log_ns` and `host`.
+  Duration shift(std::int64_t log_ns, HostTime host) {
+    std::lock_guard lock(mutex_);
+    if (!set_) {
+      shift_ = Duration::from_ns(host.ns - log_ns);
+      set_ = true;
+    }
+    return shift_;
+  }
+
+ private:
+  std::mutex mutex_;
+  bool set_ = false;
+  Duration shift_;
+};
 
 struct McapReplayConfig {
   /// the recording
@@ -40,6 +64,9 @@ struct McapReplayConfig {
   /// start again at the end; host_receive keeps increasing (each pass is shifted by the span
   /// replayed plus one inter-message gap) so clock sync downstream sees time move forward
   bool loop = false;
+  /// shared by the replay's Sources: paced at recorded timing (rate is ignored) and re-stamped
+  /// onto the host clock now; null: receive times are the recorded log times
+  std::shared_ptr<ReplayTimeline> live_timeline;
 };
 
 /// One raw channel of the stream, as recorded.

@@ -275,6 +275,22 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
         static_cast<long long>(s.clock_offset_ns), s.clock_drift_ppm, s.clock_jitter_ns,
         s.clock_uncertainty_ns, s.health.c_str());
   }
+  for (const auto& l : m.latency) {
+    if (l.topic.empty() || l.count == 0) continue;
+    if (!l.live) {
+      std::printf(
+          "  latency    %-14s %llu written  n/a (a replay's stamps, not this host's clock "
+          "now: replay with --live-stamps)\n",
+          l.topic.c_str(), static_cast<unsigned long long>(l.count));
+      continue;
+    }
+    std::printf(
+        "  latency    %-14s %llu written  receive->write p50 %.3f p99 %.3f max %.3f ms  stamp "
+        "age p50 %.3f p99 %.3f max %.3f ms\n",
+        l.topic.c_str(), static_cast<unsigned long long>(l.count), l.receive_to_write_p50_ms,
+        l.receive_to_write_p99_ms, l.receive_to_write_max_ms, l.stamp_age_p50_ms,
+        l.stamp_age_p99_ms, l.stamp_age_max_ms);
+  }
 }
 
 /// `--tum FILE`: poses as a TUM trajectory (`stamp x y z qx qy qz qw`, stamp [s] wall time, as

@@ -65,11 +65,11 @@ std::vector<std::int64_t> run_merge(unsigned seed) {
     for (int i = 1; i <= 300; ++i) {
       ImuSample s;
       s.stamp = HostTime::from_ns(i * 1000);
-      imu.push(ImuItem{s, false});
+      imu.push(ImuItem{s, false, {}});
       ready.signal();
       if (rng() % 7 == 0) std::this_thread::sleep_for(std::chrono::microseconds(rng() % 300));
     }
-    imu.push(ImuItem{{}, true});
+    imu.push(ImuItem{{}, true, {}});
     ready.signal();
   });
   std::thread scan_producer([&] {
@@ -77,11 +77,11 @@ std::vector<std::int64_t> run_merge(unsigned seed) {
     for (int i = 1; i <= 30; ++i) {
       LidarScan scan;
       scan.end_stamp = HostTime::from_ns(i * 10000 + 500);
-      scans.push(ScanItem{std::move(scan), false});
+      scans.push(ScanItem{std::move(scan), false, {}});
       ready.signal();
       std::this_thread::sleep_for(std::chrono::microseconds(rng() % 500));
     }
-    scans.push(ScanItem{{}, true});
+    scans.push(ScanItem{{}, true, {}});
     ready.signal();
   });
   // Cameras at their own rates, exposure stamps between the IMU samples' (15 Hz and 25 Hz
@@ -93,11 +93,11 @@ std::vector<std::int64_t> run_merge(unsigned seed) {
       for (int i = 1; i <= frames; ++i) {
         Image image;
         image.stamp = HostTime::from_ns(i * period + 250);
-        queue.push(ImageItem{std::move(image), false});
+        queue.push(ImageItem{std::move(image), false, {}});
         ready.signal();
         std::this_thread::sleep_for(std::chrono::microseconds(rng() % 700));
       }
-      queue.push(ImageItem{{}, true});
+      queue.push(ImageItem{{}, true, {}});
       ready.signal();
     });
   };
