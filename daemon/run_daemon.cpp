@@ -567,9 +567,12 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   if (publisher) {
     std::printf("  latency             %s\n", odom_latency.line(live_clock).c_str());
     std::printf("                      %s\n", pose_latency.line(live_clock).c_str());
+    const std::string_view mode = pipe.odometry_mode();
     std::printf("  odometry            %s\n",
-                pipe.odometry_decoupled()
+                mode == "imu_thread"
                     ? "propagated on the IMU thread from the newest optimised state"
+                : mode == "in_order"
+                    ? "propagated from the optimised states in data order (max-speed replay)"
                     : "propagated by the back end after each measurement");
   }
   if (recorder) {

@@ -69,13 +69,12 @@ FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<Fusi
 void FusionStage::route_states() {
   for (NavState& state : produced_) {
     state.received = newest_received_;
-    if (odometry_.anchors == nullptr) {
+    if (odometry_.anchors == nullptr && odometry_.in_order == nullptr) {
       outgoing_.push_back(state);
       continue;
     }
-    if (state.anchor) {
-      odometry_.anchors->push(AnchorItem{state, imu_consumed_});
-    }
+    if (state.anchor && odometry_.anchors != nullptr) odometry_.anchors->push(AnchorItem{state});
+    if (state.anchor && odometry_.in_order != nullptr) odometry_.in_order->set_anchor(state);
     // The core's own propagation is replaced by the odometry path's.
     if (state.optimised) outgoing_.push_back(state);
   }
@@ -139,14 +138,16 @@ void FusionStage::run() {
         case Next::kImu: {
           ImuItem item = imu.take();
           newest_received_ = std::max(newest_received_, item.received);
-          core_->add_imu(item.sample, produced_);
-          imu_consumed_ = item.sample.stamp;
-          if (odometry_.progress != nullptr) {
-            // The anchors this sample released go out before the progress that lets the
-            // odometry look for them.
+          if (odometry_.in_order != nullptr) {
+            // From the anchors released before this sample, as the IMU stage would live.
             route_states();
-            odometry_.progress->consumed_imu(imu_consumed_);
+            NavState odom;
+            if (odometry_.in_order->add_imu(item.sample, odom)) {
+              odom.received = item.received;
+              outgoing_.push_back(odom);
+            }
           }
+          core_->add_imu(item.sample, produced_);
           break;
         }
         case Next::kScan: {
@@ -187,7 +188,6 @@ void FusionStage::run() {
     if (!handed) inputs_ready_.wait_for(kStageWaitTimeout);
   }
   counters_.publish_figures(core_->figures());
-  if (odometry_.progress != nullptr) odometry_.progress->ended();
   states_.push(StateItem{{}, true});
   publisher_.signal();
 }

@@ -10,9 +10,11 @@
 // the data alone, however the threads were scheduled: max-speed replays are deterministic. Live,
 // waiting for the slowest sensor would add its period to every pose's latency, so the stage hands
 // over whatever has arrived, oldest first, and the core's MeasurementGate orders the rest.
+//
+// Odometry (OdometryHandover): the states the core optimised are anchors for IMU-rate odometry,
+// which runs on the IMU stage's thread live and on this one, in data order, in max-speed replays.
 
 #include <atomic>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -48,11 +50,14 @@ struct FusionCounters {
   FusionFigures figures_;
 };
 
-/// Where the back end's anchors go when odometry runs apart from it (OdometryPath); with it, the
-/// core's own IMU propagation (late by a scan match) is not published.
+/// Odometry from the back end's anchors (optimised states) instead of the core's own IMU
+/// propagation, which waits behind every scan match. At most one is set.
 struct OdometryHandover {
+  /// live (and paced replays): the anchors go to the IMU stage's OdometryPath
   SpscQueue<AnchorItem>* anchors = nullptr;
-  BackEndProgress* progress = nullptr;
+  /// max-speed replays: this stage propagates each IMU sample itself, in data order, from the
+  /// anchors released before it, so the odometry is the same on every run
+  estimator::OdometryPropagator* in_order = nullptr;
 };
 
 struct FusionInputs {
@@ -96,8 +101,6 @@ class FusionStage {
   std::vector<NavState> outgoing_;
   /// the newest receive stamp of everything handed to the core (NavState::received)
   HostTime newest_received_;
-  /// the newest IMU stamp handed to the core (AnchorItem::released_at)
-  HostTime imu_consumed_ = HostTime::from_ns(std::numeric_limits<std::int64_t>::min());
 };
 
 }  // namespace posed::pipeline

@@ -51,11 +51,7 @@ void ImuStage::push(const ImuSample& sample) {
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
   pushed_ = true;
-  if (odometry_ != nullptr) {
-    // The back end gets the sample first: a deterministic replay's odometry waits for it.
-    consumer_.signal();
-    odometry_->on_imu(sample, chunk_received_, heartbeat_);
-  }
+  if (odometry_ != nullptr) odometry_->on_imu(sample, chunk_received_);
 }
 
 // Frames the decoder rejected since the last look (CRC, truncation, unknown kind).

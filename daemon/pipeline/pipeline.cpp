@@ -190,15 +190,17 @@ bool Pipeline::start(std::string& error) {
     odometry.accel_noise_density = lio_settings.noise.accel_noise_density;
     odometry.gyro_noise_density = lio_settings.noise.gyro_noise_density;
     odometry.blend_s = config_.publish.odom_blend_s;
-    anchor_queue_ = std::make_unique<SpscQueue<AnchorItem>>(256, queue_policy(sources_.imu.get()),
-                                                            block_timeout(sources_.imu.get()));
-    back_end_progress_ = std::make_unique<BackEndProgress>();
-    // Max-speed replays wait for the back end so odometry is a function of the data alone.
-    const bool deterministic = in_stamp_order && !sources_.paced;
-    odometry_ = std::make_unique<OdometryPath>(odometry, *anchor_queue_, *back_end_progress_,
-                                               deterministic, outputs_.on_odom);
-    imu_stage_->set_odometry(odometry_.get());
-    handover = OdometryHandover{anchor_queue_.get(), back_end_progress_.get()};
+    if (in_stamp_order && !sources_.paced) {
+      // Max speed: the fusion stage propagates in data order (deterministic; no one waits).
+      in_order_odometry_ = std::make_unique<estimator::OdometryPropagator>(odometry);
+      handover.in_order = in_order_odometry_.get();
+    } else {
+      anchor_queue_ = std::make_unique<SpscQueue<AnchorItem>>(256, queue_policy(sources_.imu.get()),
+                                                              block_timeout(sources_.imu.get()));
+      odometry_ = std::make_unique<OdometryPath>(odometry, *anchor_queue_, outputs_.on_odom);
+      imu_stage_->set_odometry(odometry_.get());
+      handover.anchors = anchor_queue_.get();
+    }
   }
   fusion_stage_ = std::make_unique<FusionStage>(
       config_, std::move(core),

@@ -89,7 +89,8 @@ struct PipelineOutputs {
   /// decimated propagation, on rt/posed/pose); without the odometry below, the propagation too
   std::function<void(const NavState&)> on_state;
   /// IMU-rate odometry kept apart from the back end (publish.odom_decoupled, with a lidar),
-  /// called on the IMU stage's thread; null: the back end's own propagation goes to on_state
+  /// called on the IMU stage's thread; in max-speed replays it comes through on_state instead
+  /// (made in data order on the fusion thread). Null: the core's own propagation, on_state.
   std::function<void(const NavState&)> on_odom;
   /// at publish.status_rate_hz, and once more at the end of the stream
   std::function<void(const PipelineStatus&)> on_status;
@@ -131,8 +132,12 @@ class Pipeline {
   std::vector<StageBeat> stage_heartbeats() const;
   /// A snapshot, safe from any thread.
   PipelineStatus status() const;
-  /// True when odometry runs apart from the back end (on_odom gets it; valid after start()).
-  bool odometry_decoupled() const { return odometry_ != nullptr; }
+  /// How rt/posed/odom is made (valid after start()): "imu_thread" (on_odom gets it),
+  /// "in_order" (max-speed replay: from the anchors, on the fusion thread, through on_state) or
+  /// "back_end" (the core's own propagation, through on_state).
+  std::string_view odometry_mode() const {
+    return odometry_ ? "imu_thread" : in_order_odometry_ ? "in_order" : "back_end";
+  }
   /// The fusion core's one-line description (valid after start()).
   std::string estimator_description() const;
   /// The fusion core's map and keyframes (call after join(); empty without a lidar or keep_map).
@@ -170,10 +175,11 @@ class Pipeline {
   /// the fusion core when it has cameras (owned by fusion_stage_)
   const fusion::CameraAidedCore* camera_core_ = nullptr;
   std::unique_ptr<PublisherStage> publisher_stage_;
-  /// odometry apart from the back end: its anchors, the back end's progress, the path itself
+  /// odometry apart from the back end, live: its anchors and the IMU stage's path
   std::unique_ptr<SpscQueue<AnchorItem>> anchor_queue_;
-  std::unique_ptr<BackEndProgress> back_end_progress_;
   std::unique_ptr<OdometryPath> odometry_;
+  /// the same in a max-speed replay, on the fusion stage's thread in data order
+  std::unique_ptr<estimator::OdometryPropagator> in_order_odometry_;
   bool started_ = false;
   std::atomic<std::size_t> finished_stages_{0};
   std::vector<std::thread> threads_;
