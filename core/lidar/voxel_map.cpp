@@ -1,6 +1,7 @@
 #include "core/lidar/voxel_map.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace posed::lidar {
@@ -55,6 +56,32 @@ void VoxelMap::insert(const std::vector<Eigen::Vector3f>& points_map) {
   }
 }
 
+namespace {
+
+/// The 27 voxels around a query's, nearest class first (itself, the 6 sharing a face, the 12
+/// sharing an edge, the 8 sharing a corner), so the k best are found early and farther voxels
+/// can be skipped without being looked up.
+struct Offset {
+  int d[3];
+};
+constexpr std::array<Offset, 27> kByDistance = [] {
+  std::array<Offset, 27> out{};
+  std::size_t n = 0;
+  for (int manhattan = 0; manhattan <= 3; ++manhattan) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const int m = (dx != 0) + (dy != 0) + (dz != 0);
+          if (m == manhattan) out[n++] = Offset{{dx, dy, dz}};
+        }
+      }
+    }
+  }
+  return out;
+}();
+
+}  // namespace
+
 int VoxelMap::nearest(const Eigen::Vector3f& query, int k, float max_distance_m,
                       Eigen::Vector3f* out) const {
   // A sorted insertion into a tiny array (k <= ~8) beats a heap.
@@ -63,24 +90,35 @@ int VoxelMap::nearest(const Eigen::Vector3f& query, int k, float max_distance_m,
   int found = 0;
   const float max_d2 = max_distance_m * max_distance_m;
   const Eigen::Vector3i centre = voxel_of(query);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
-        const auto it = index_.find(key_of(centre + Eigen::Vector3i(dx, dy, dz)));
-        if (it == index_.end()) continue;
-        for (const Eigen::Vector3f& p : voxels_[it->second].points) {
-          const float d2 = (p - query).squaredNorm();
-          if (d2 > max_d2 || (found == kk && d2 >= best_d2[kk - 1])) continue;
-          int pos = found < kk ? found++ : kk - 1;
-          while (pos > 0 && best_d2[pos - 1] > d2) {
-            best_d2[pos] = best_d2[pos - 1];
-            out[pos] = out[pos - 1];
-            --pos;
-          }
-          best_d2[pos] = d2;
-          out[pos] = p;
-        }
+  // Squared distance from the query to the faces of its voxel, per axis: [lower, 0, upper]. A
+  // neighbour voxel's points are at least the sum over its offset axes away, which skips the
+  // voxels that cannot hold a better point (made a hair smaller than exact, so float rounding at
+  // a voxel face never skips a point that would have been taken).
+  const float voxel = static_cast<float>(config_.voxel_m);
+  float face_d2[3][3];
+  for (int a = 0; a < 3; ++a) {
+    const float into = query[a] - static_cast<float>(centre[a]) * voxel;
+    const float lower = std::max(0.f, into - 1e-4f), upper = std::max(0.f, voxel - into - 1e-4f);
+    face_d2[a][0] = lower * lower;
+    face_d2[a][1] = 0.f;
+    face_d2[a][2] = upper * upper;
+  }
+  for (const Offset& o : kByDistance) {
+    const float box_d2 = face_d2[0][o.d[0] + 1] + face_d2[1][o.d[1] + 1] + face_d2[2][o.d[2] + 1];
+    if (box_d2 > max_d2 || (found == kk && box_d2 >= best_d2[kk - 1])) continue;
+    const auto it = index_.find(key_of(centre + Eigen::Vector3i(o.d[0], o.d[1], o.d[2])));
+    if (it == index_.end()) continue;
+    for (const Eigen::Vector3f& p : voxels_[it->second].points) {
+      const float d2 = (p - query).squaredNorm();
+      if (d2 > max_d2 || (found == kk && d2 >= best_d2[kk - 1])) continue;
+      int pos = found < kk ? found++ : kk - 1;
+      while (pos > 0 && best_d2[pos - 1] > d2) {
+        best_d2[pos] = best_d2[pos - 1];
+        out[pos] = out[pos - 1];
+        --pos;
       }
+      best_d2[pos] = d2;
+      out[pos] = p;
     }
   }
   return found;
