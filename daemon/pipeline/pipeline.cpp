@@ -98,14 +98,6 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
         static_cast<std::size_t>(config.queues.image_capacity), queue_policy(source),
         block_timeout(source));
   }
-  // The order of stage_names(): what the watchdog and the summary list.
-  add_stage("imu_source");
-  if (sources_.lidar) add_stage("lidar_source");
-  for (const CameraStream s : kCameraStreams) {
-    if (sources_.camera(s)) add_stage(stage_name(s));
-  }
-  add_stage("fusion");
-  add_stage("publisher");
 }
 
 Pipeline::~Pipeline() {
@@ -113,20 +105,25 @@ Pipeline::~Pipeline() {
   join();
 }
 
-Heartbeat& Pipeline::add_stage(std::string name) {
-  heartbeats_.push_back(std::make_unique<Heartbeat>(std::move(name)));
-  return *heartbeats_.back();
+void Pipeline::add_stage(std::string name,
+                         const std::function<std::function<void()>(Heartbeat&)>& make) {
+  Stage stage;
+  stage.heartbeat = std::make_unique<Heartbeat>(std::move(name));
+  stage.run = make(*stage.heartbeat);
+  stages_.push_back(std::move(stage));
 }
 
 std::vector<std::string> Pipeline::stage_names() const {
   std::vector<std::string> names;
-  for (const auto& h : heartbeats_) names.push_back(h->name());
+  for (const auto& stage : stages_) names.push_back(stage.heartbeat->name());
   return names;
 }
 
 std::vector<StageBeat> Pipeline::stage_heartbeats() const {
   std::vector<StageBeat> beats;
-  for (const auto& h : heartbeats_) beats.push_back(StageBeat{h->name(), h->last()});
+  for (const auto& stage : stages_) {
+    beats.push_back(StageBeat{stage.heartbeat->name(), stage.heartbeat->last()});
+  }
   return beats;
 }
 
@@ -154,20 +151,30 @@ bool Pipeline::start(std::string& error) {
                                                                       calibration, error);
     if (!loaded) return false;
   }
-  std::size_t stage = 0;
-  imu_stage_ = std::make_unique<ImuStage>(config_, *sources_.imu, imu_queue_, fusion_ready_,
-                                          *heartbeats_[stage++], imu_counters_);
+  // Every stage is registered here, in the order stage_names() lists them (what the watchdog and
+  // the summary show): its heartbeat, the object that runs on its thread, and its thread's body.
+  add_stage("imu_source", [&](Heartbeat& beat) {
+    imu_stage_ = std::make_unique<ImuStage>(config_, *sources_.imu, imu_queue_, fusion_ready_, beat,
+                                            imu_counters_);
+    return [this] { imu_stage_->run(); };
+  });
   if (sources_.lidar) {
-    lidar_stage_ = std::make_unique<LidarStage>(config_, std::move(calibration), *sources_.lidar,
-                                                *scan_queue_, fusion_ready_, *heartbeats_[stage++],
-                                                lidar_counters_, *scan_counters_);
+    add_stage("lidar_source", [&](Heartbeat& beat) {
+      lidar_stage_ = std::make_unique<LidarStage>(config_, std::move(calibration), *sources_.lidar,
+                                                  *scan_queue_, fusion_ready_, beat,
+                                                  lidar_counters_, *scan_counters_);
+      return [this] { lidar_stage_->run(); };
+    });
   }
   for (const CameraStream s : kCameraStreams) {
     if (!sources_.camera(s)) continue;
-    const std::size_t i = index_of(s);
-    camera_stages_[i] =
-        std::make_unique<CameraStage>(config_, s, *sources_.camera(s), *image_queues_[i],
-                                      fusion_ready_, *heartbeats_[stage++], camera_counters_[i]);
+    add_stage(stage_name(s), [&](Heartbeat& beat) {
+      const std::size_t i = index_of(s);
+      camera_stages_[i] =
+          std::make_unique<CameraStage>(config_, s, *sources_.camera(s), *image_queues_[i],
+                                        fusion_ready_, beat, camera_counters_[i]);
+      return [stage = camera_stages_[i].get()] { stage->run(); };
+    });
   }
   // Recordings and generators at full speed: merge by stamp so replays are deterministic.
   bool in_stamp_order = !sources_.imu->live();
@@ -202,14 +209,21 @@ bool Pipeline::start(std::string& error) {
       handover.anchors = anchor_queue_.get();
     }
   }
-  fusion_stage_ = std::make_unique<FusionStage>(
-      config_, std::move(core),
-      FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get()},
-      in_stamp_order, state_queue_, fusion_ready_, state_ready_, *heartbeats_[stage++],
-      *fusion_counters_, handover);
-  publisher_stage_ = std::make_unique<PublisherStage>(
-      config_, state_queue_, state_ready_, *heartbeats_[stage++], outputs_.on_state,
-      outputs_.on_status, [this] { return status(); });
+  add_stage("fusion", [&](Heartbeat& beat) {
+    fusion_stage_ =
+        std::make_unique<FusionStage>(config_, std::move(core),
+                                      FusionInputs{&imu_queue_, scan_queue_.get(),
+                                                   image_queues_[0].get(), image_queues_[1].get()},
+                                      in_stamp_order, state_queue_, fusion_ready_, state_ready_,
+                                      beat, *fusion_counters_, handover);
+    return [this] { fusion_stage_->run(); };
+  });
+  add_stage("publisher", [&](Heartbeat& beat) {
+    publisher_stage_ = std::make_unique<PublisherStage>(config_, state_queue_, state_ready_, beat,
+                                                        outputs_.on_state, outputs_.on_status,
+                                                        [this] { return status(); });
+    return [this] { publisher_stage_->run(); };
+  });
 
   if (sources_.lidar) {
     std::string lidar_error;
@@ -236,15 +250,9 @@ bool Pipeline::start(std::string& error) {
   // runs sequentially on the fusion thread.
   cv::setNumThreads(0);
   const HostTime now = drivers::host_now();
-  for (auto& h : heartbeats_) h->reset(now);
+  for (auto& stage : stages_) stage.heartbeat->reset(now);
   started_ = true;
-  launch([this] { imu_stage_->run(); });
-  if (lidar_stage_) launch([this] { lidar_stage_->run(); });
-  for (auto& camera : camera_stages_) {
-    if (camera) launch([stage = camera.get()] { stage->run(); });
-  }
-  launch([this] { fusion_stage_->run(); });
-  launch([this] { publisher_stage_->run(); });
+  for (auto& stage : stages_) launch(stage.run);
   return true;
 }
 

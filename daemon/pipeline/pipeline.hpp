@@ -122,7 +122,7 @@ class Pipeline {
   /// Drain: Sources stop, queued data flows through, threads end. Safe from any thread.
   void request_stop();
   /// True once every stage thread has finished.
-  bool finished() const { return started_ && finished_stages_.load() == heartbeats_.size(); }
+  bool finished() const { return started_ && finished_stages_.load() == stages_.size(); }
   /// The stages this pipeline runs (the lidar stage only with a lidar Source).
   std::vector<std::string> stage_names() const;
   /// Joins the threads (call after finished() or request_stop()).
@@ -146,7 +146,8 @@ class Pipeline {
   std::vector<CameraFigures> camera_compare_figures() const;
 
  private:
-  Heartbeat& add_stage(std::string name);
+  /// Registers a stage: `make` builds it with its heartbeat and returns its thread's body.
+  void add_stage(std::string name, const std::function<std::function<void()>(Heartbeat&)>& make);
   void launch(std::function<void()> body);
 
   config::PosedConfig config_;
@@ -166,7 +167,12 @@ class Pipeline {
   StreamCounters camera_counters_[2];
   std::unique_ptr<LidarScanCounters> scan_counters_;
   std::unique_ptr<FusionCounters> fusion_counters_;
-  std::vector<std::unique_ptr<Heartbeat>> heartbeats_;
+  /// every stage this pipeline runs, in stage_names() order (add_stage())
+  struct Stage {
+    std::unique_ptr<Heartbeat> heartbeat;
+    std::function<void()> run;
+  };
+  std::vector<Stage> stages_;
 
   std::unique_ptr<ImuStage> imu_stage_;
   std::unique_ptr<LidarStage> lidar_stage_;

@@ -1,0 +1,188 @@
+#include "daemon/pose_sinks.hpp"
+
+#include <cstdio>
+
+#include "daemon/build_info.hpp"
+#include "daemon/dds/publisher.hpp"
+#include "drivers/common/host_clock.hpp"
+#include "drivers/recording/recorder.hpp"
+
+namespace posed {
+namespace {
+
+std::array<double, 36> to_row_major(const Eigen::Matrix<double, 6, 6>& m) {
+  std::array<double, 36> out{};
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) out[static_cast<std::size_t>(r * 6 + c)] = m(r, c);
+  }
+  return out;
+}
+
+}  // namespace
+
+PoseSinks::PoseSinks(const config::PosedConfig& config, dds::Publisher* publisher,
+                     drivers::recording::Recorder* recorder, HostToWall to_wall, HostTime started,
+                     bool live_clock)
+    : config_(config),
+      publisher_(publisher),
+      recorder_(recorder),
+      to_wall_(to_wall),
+      started_(started),
+      live_clock_(live_clock),
+      pose_period_(Duration::from_seconds(1.0 / config.publish.pose_rate_hz)) {}
+
+void PoseSinks::odom(const NavState& s) {
+  if (tally_.last) tally_.distance_m += (s.p_map_base_m - tally_.last->p_map_base_m).norm();
+  if (!tally_.first) tally_.first = s;
+  tally_.last = s;
+  if (odom_index_++ % static_cast<std::uint64_t>(config_.publish.odom_decimation) != 0) return;
+  const WallTime stamp = to_wall_(s.stamp);
+  if (publisher_) {
+    dds::OdomMessage odom;
+    odom.stamp = stamp;
+    odom.p_map_base_m = s.p_map_base_m;
+    odom.q_map_base = s.q_map_base;
+    odom.v_base_mps = s.q_map_base.conjugate() * s.v_map_mps;
+    odom.w_base_radps = s.w_base_radps;
+    odom.pose_covariance = to_row_major(s.pose_covariance);
+    odom.twist_covariance = to_row_major(s.twist_covariance);
+    if (publisher_->publish_odom(odom)) {
+      odom_latency_.record(s, drivers::host_now());
+      tally_.odom.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      tally_.failed.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+  if (recorder_) {
+    // After the write: the recording must never delay the odometry.
+    const Eigen::Quaterniond& q = s.q_map_base;
+    const Eigen::Vector3d v_base = s.q_map_base.conjugate() * s.v_map_mps;
+    recorder_->write_odometry("/posed/odom", stamp, config_.dds.map_frame, config_.dds.base_frame,
+                              {s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z()},
+                              {q.x(), q.y(), q.z(), q.w()}, {v_base.x(), v_base.y(), v_base.z()},
+                              {s.w_base_radps.x(), s.w_base_radps.y(), s.w_base_radps.z()});
+  }
+}
+
+void PoseSinks::state(const NavState& s) {
+  const WallTime stamp = to_wall_(s.stamp);
+  // Optimised states (one per scan) go on rt/posed/pose; IMU propagation (when the back end
+  // makes it) on rt/posed/odom. An estimator without optimised states (strapdown) has its
+  // propagation decimated onto pose.
+  if (s.optimised) tally_.have_optimised = true;
+  if (!s.optimised) odom(s);
+  const bool pose_now =
+      s.optimised || (!tally_.have_optimised && s.stamp >= tally_.next_pose_stamp);
+  if (pose_now) {
+    tally_.next_pose_stamp = s.stamp + pose_period_;
+    dds::PoseMessage pose;
+    pose.stamp = stamp;
+    pose.p_map_base_m = s.p_map_base_m;
+    pose.q_map_base = s.q_map_base;
+    if (!publisher_) {
+      // offline run: nothing to publish
+    } else if (publisher_->publish_pose(pose)) {
+      pose_latency_.record(s, drivers::host_now());
+      ++tally_.pose;
+    } else {
+      tally_.failed.fetch_add(1, std::memory_order_relaxed);
+    }
+    if (recorder_) {
+      const Eigen::Quaterniond& q = s.q_map_base;
+      recorder_->write_pose("/posed/pose", stamp, config_.dds.map_frame,
+                            {s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z()},
+                            {q.x(), q.y(), q.z(), q.w()});
+    }
+  }
+}
+
+void PoseSinks::status(const pipeline::PipelineStatus& st) {
+  dds::StatusMessage msg;
+  msg.stamp = to_wall_(st.stamp);
+  msg.version = std::string(version_string());
+  msg.estimator_mode = std::string(to_string(st.mode));
+  const FusionFigures& f = st.estimator;
+  msg.estimator = {
+      f.scans_used,        f.scans_rejected, f.scans_degenerate,      f.scans_skipped,
+      f.reinitialisations, f.keyframes,      f.degenerate_directions, f.gyro_bias_radps,
+      f.accel_bias_mps2};
+  const CameraFigures& cam = f.camera;
+  msg.camera.mode = std::string(cam.mode);
+  msg.camera.frames = cam.frames;
+  msg.camera.frames_unusable = cam.frames_unusable + cam.frames_without_imu;
+  msg.camera.features = cam.features;
+  msg.camera.depth_associated = cam.depth_associated;
+  msg.camera.match_success_rate = cam.match_success_rate();
+  for (std::size_t i = 0; i < 3; ++i) {
+    msg.camera.confidence[i] = cam.quality[i].valid ? cam.quality[i].confidence : 0.0;
+    msg.camera.omega[i] = cam.quality[i].valid ? cam.quality[i].omega : 0.0;
+  }
+  msg.modalities = modality_names(f.modalities);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const VisualStreamFigures& v = f.visual[i];
+    msg.visual[i] = {v.configured,
+                     v.active,
+                     v.omega,
+                     v.confidence,
+                     v.factors,
+                     v.failed + v.no_frames + v.implausible,
+                     v.gated_out,
+                     v.left,
+                     v.rejoined,
+                     v.inliers,
+                     v.reprojection_rms_px,
+                     v.residual_median};
+  }
+  msg.selection = {f.selection.lidar_visual_inertial, f.selection.lidar_inertial,
+                   f.selection.visual_inertial, f.selection.imu_only, f.selection.last_threshold_m};
+  msg.uptime_s = (st.stamp - started_).seconds();
+  msg.latency = {odom_latency_.message(live_clock_), pose_latency_.message(live_clock_)};
+  std::string line = std::string(to_string(st.mode));
+  for (const auto& s : st.streams) {
+    dds::StreamStatusMessage m;
+    m.name = s.name;
+    m.rate_hz = s.rate_hz;
+    m.received = s.received;
+    m.decoded = s.decoded;
+    m.dropped = s.dropped;
+    m.malformed = s.malformed;
+    m.clock_offset_ns = s.clock_offset_ns;
+    m.clock_drift_ppm = s.clock_drift_ppm;
+    m.clock_jitter_ns = s.clock_jitter_ns;
+    m.clock_uncertainty_ns = s.clock_uncertainty_ns;
+    m.clock_state = s.clock_state;
+    m.health = s.health;
+    msg.streams.push_back(std::move(m));
+    char part[160];
+    std::snprintf(part, sizeof part, "; %s %.0f Hz %s clock %s", s.name.c_str(), s.rate_hz,
+                  s.health.c_str(), s.clock_state.c_str());
+    line += part;
+  }
+  char odom_part[96];
+  if (live_clock_ && odom_latency_.receive_to_write.count() > 0) {
+    std::snprintf(odom_part, sizeof odom_part, "; %llu odom published, p99 %.2f ms late",
+                  static_cast<unsigned long long>(tally_.odom.load()),
+                  static_cast<double>(odom_latency_.receive_to_write.percentile_ns(0.99)) * 1e-6);
+  } else {
+    std::snprintf(odom_part, sizeof odom_part, "; %llu odom published",
+                  static_cast<unsigned long long>(tally_.odom.load()));
+  }
+  line += odom_part;
+  msg.summary = line;
+  if (!publisher_) {
+    // offline run: nothing to publish
+  } else if (publisher_->publish_status(msg)) {
+    ++tally_.status;
+  } else {
+    tally_.failed.fetch_add(1, std::memory_order_relaxed);
+  }
+  std::lock_guard lock(status_line_mutex_);
+  status_line_ = line;
+}
+
+std::string PoseSinks::status_line() const {
+  std::lock_guard lock(status_line_mutex_);
+  return status_line_;
+}
+
+}  // namespace posed

@@ -1,0 +1,133 @@
+#pragma once
+// Where the pipeline's states and status go (run_daemon): rt/posed/odom, rt/posed/pose and
+// rt/posed/status on DDS, /posed/odom and /posed/pose in the recording, and what the exit
+// summary reads (counts, each topic's latency, the first and last odometry). A new sink is added
+// here, not in run_daemon's wiring.
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "core/estimator/nav_state.hpp"
+#include "core/time.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/dds/messages.hpp"
+#include "daemon/pipeline/latency_histogram.hpp"
+#include "daemon/pipeline/pipeline_status.hpp"
+
+namespace posed {
+
+namespace dds {
+class Publisher;
+}
+namespace drivers::recording {
+class Recorder;
+}
+
+/// One topic's latency at its DDS write (rt/posed/status, the summary).
+struct TopicLatency {
+  const char* topic;
+  pipeline::LatencyHistogram receive_to_write;
+  pipeline::LatencyHistogram stamp_age;
+
+  /// Right after the write of a message made from `s`; `now` on the host clock.
+  void record(const NavState& s, HostTime now) {
+    if (s.received.ns != 0) receive_to_write.record(now - s.received);
+    stamp_age.record(now - s.stamp);
+  }
+  dds::TopicLatencyMessage message(bool live) const {
+    dds::TopicLatencyMessage m;
+    m.topic = topic;
+    m.count = stamp_age.count();
+    m.live = live;
+    if (!live) return m;
+    const pipeline::LatencySummary r = receive_to_write.summary(), a = stamp_age.summary();
+    m.receive_to_write_p50_ms = r.p50_ms;
+    m.receive_to_write_p99_ms = r.p99_ms;
+    m.receive_to_write_max_ms = r.max_ms;
+    m.stamp_age_p50_ms = a.p50_ms;
+    m.stamp_age_p99_ms = a.p99_ms;
+    m.stamp_age_max_ms = a.max_ms;
+    return m;
+  }
+  /// The summary's line: "rt/posed/odom  12000 written, receive->write p50 ... ms".
+  std::string line(bool live) const {
+    char buf[320];
+    const dds::TopicLatencyMessage m = message(live);
+    if (!live) {
+      std::snprintf(buf, sizeof buf,
+                    "%-14s %llu written; n/a (a replay's stamps are not this host's clock now: "
+                    "--live-stamps)",
+                    topic, static_cast<unsigned long long>(m.count));
+    } else {
+      std::snprintf(buf, sizeof buf,
+                    "%-14s %llu written; receive->write p50 %.3f, p99 %.3f, max %.3f ms; stamp "
+                    "age p50 %.3f, p99 %.3f, max %.3f ms",
+                    topic, static_cast<unsigned long long>(m.count), m.receive_to_write_p50_ms,
+                    m.receive_to_write_p99_ms, m.receive_to_write_max_ms, m.stamp_age_p50_ms,
+                    m.stamp_age_p99_ms, m.stamp_age_max_ms);
+    }
+    return buf;
+  }
+};
+
+/// What was published, for the summary (read after the threads end). Odometry is written by
+/// one thread (the IMU stage's, or the publisher's when it is not decoupled), poses and status
+/// by the publisher's.
+struct PublishTally {
+  std::atomic<std::uint64_t> odom{0};
+  std::uint64_t pose = 0;
+  std::uint64_t status = 0;
+  std::atomic<std::uint64_t> failed{0};
+  std::optional<NavState> first;
+  std::optional<NavState> last;
+  double distance_m = 0;
+  HostTime next_pose_stamp;
+  /// the estimator publishes optimised states (so pose is not decimated from odom)
+  bool have_optimised = false;
+};
+
+class PoseSinks {
+ public:
+  /// `publisher` or `recorder` null: that sink is off. `live_clock`: the stamps are this host's
+  /// clock now (live, or a replay with --live-stamps), so latencies can be measured.
+  PoseSinks(const config::PosedConfig& config, dds::Publisher* publisher,
+            drivers::recording::Recorder* recorder, HostToWall to_wall, HostTime started,
+            bool live_clock);
+
+  /// IMU-rate odometry: rt/posed/odom (every publish.odom_decimation-th) and /posed/odom. From
+  /// one thread at a time.
+  void odom(const NavState& s);
+  /// A state from the publisher stage: optimised ones on rt/posed/pose and /posed/pose; the
+  /// back end's propagation (when odometry is not decoupled) to odom(), and decimated onto pose
+  /// for an estimator without optimised states.
+  void state(const NavState& s);
+  /// rt/posed/status, and the line for systemd's STATUS=.
+  void status(const pipeline::PipelineStatus& st);
+
+  /// The last status line ("starting" before the first status); safe from any thread.
+  std::string status_line() const;
+  const PublishTally& tally() const { return tally_; }
+  const TopicLatency& odom_latency() const { return odom_latency_; }
+  const TopicLatency& pose_latency() const { return pose_latency_; }
+  bool live_clock() const { return live_clock_; }
+
+ private:
+  const config::PosedConfig& config_;
+  dds::Publisher* publisher_;
+  drivers::recording::Recorder* recorder_;
+  HostToWall to_wall_;
+  HostTime started_;
+  bool live_clock_;
+  Duration pose_period_;
+  std::uint64_t odom_index_ = 0;
+  PublishTally tally_;
+  TopicLatency odom_latency_{"rt/posed/odom", {}, {}};
+  TopicLatency pose_latency_{"rt/posed/pose", {}, {}};
+  mutable std::mutex status_line_mutex_;
+  std::string status_line_ = "starting";
+};
+
+}  // namespace posed

@@ -1,0 +1,153 @@
+#include "daemon/run_summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "daemon/estimator_summary.hpp"
+#include "daemon/pipeline/pipeline.hpp"
+#include "drivers/common/host_clock.hpp"
+#include "drivers/recording/recorder.hpp"
+#include "drivers/synthetic/synthetic_imu_source.hpp"
+
+namespace posed {
+namespace {
+
+double yaw_deg(const Eigen::Quaterniond& q) {
+  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+  return std::atan2(x.y(), x.x()) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+bool print_run_summary(const RunSummary& r) {
+  const PublishTally& tally = r.sinks.tally();
+  const pipeline::PipelineStatus st = r.pipe.status();
+  const double run_s = (drivers::host_now() - r.started).seconds();
+  std::printf("\nposed summary\n");
+  std::printf("  run time            %.1f s\n", run_s);
+  std::printf("  estimator           %s, last mode %s\n", r.pipe.estimator_description().c_str(),
+              std::string(to_string(st.mode)).c_str());
+  for (const auto& s : st.streams) {
+    // Chunks nothing could decode are a configuration problem, not damaged data: said apart.
+    char undecodable[80] = "";
+    if (s.undecodable > 0) {
+      std::snprintf(undecodable, sizeof undecodable, " (%llu with no decoder configured)",
+                    static_cast<unsigned long long>(s.undecodable));
+    }
+    std::printf(
+        "  %-19s %llu decoded (%.1f Hz mean), %llu malformed%s, %llu dropped; clock %s, "
+        "offset %.3f ms, drift %.1f ppm\n",
+        s.name.c_str(), static_cast<unsigned long long>(s.decoded),
+        run_s > 0 ? static_cast<double>(s.decoded) / run_s : 0.0,
+        static_cast<unsigned long long>(s.malformed), undecodable,
+        static_cast<unsigned long long>(s.dropped), s.clock_state.c_str(),
+        static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
+  }
+  if (!r.options.replay.path.empty()) {
+    std::printf("  replayed            %s (%s)\n", r.options.replay.path.c_str(),
+                r.replay_streams.c_str());
+    // What a replay costs: the span of data turned into poses per second of wall time.
+    const double processing_s = (drivers::host_now() - r.pipeline_started).seconds();
+    if (tally.first && tally.last && processing_s > 0) {
+      const double span_s = (tally.last->stamp - tally.first->stamp).seconds();
+      std::printf("  real-time factor    %.2fx (%.1f s of data in %.1f s)\n", span_s / processing_s,
+                  span_s, processing_s);
+    }
+  }
+  if (r.has_lidar) {
+    std::printf(
+        "  lidar scans         %llu assembled (%.0f points/scan mean), %llu reached the "
+        "fusion core, %llu used by the estimator\n",
+        static_cast<unsigned long long>(st.lidar_scans),
+        st.lidar_scans ? static_cast<double>(st.lidar_points) / static_cast<double>(st.lidar_scans)
+                       : 0.0,
+        static_cast<unsigned long long>(st.lidar_scans_fused),
+        static_cast<unsigned long long>(st.estimator.scans_used));
+  }
+  if (r.has_lidar) {
+    const FusionFigures& f = st.estimator;
+    std::printf(
+        "  scan matching       %llu used, %llu rejected, %llu degenerate, %llu skipped; %llu "
+        "keyframes; %llu re-initialisations; %llu weak directions overruled by the cameras\n",
+        static_cast<unsigned long long>(f.scans_used),
+        static_cast<unsigned long long>(f.scans_rejected),
+        static_cast<unsigned long long>(f.scans_degenerate),
+        static_cast<unsigned long long>(f.scans_skipped),
+        static_cast<unsigned long long>(f.keyframes),
+        static_cast<unsigned long long>(f.reinitialisations),
+        static_cast<unsigned long long>(f.lidar_directions_overruled));
+    std::printf("  IMU biases          gyro [%.5f %.5f %.5f] rad/s, accel [%.4f %.4f %.4f] m/s^2\n",
+                f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
+                f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());
+  }
+  if (!st.estimator.camera.mode.empty()) {
+    const CameraFigures& c = st.estimator.camera;
+    const double frames = static_cast<double>(std::max<std::uint64_t>(c.frames, 1));
+    std::printf(
+        "  camera front end    %s: %llu frames (%llu unusable, %llu without IMU), %.0f "
+        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features, %llu tracks "
+        "dropped as fixed to the camera, %llu frozen thermal frames left out; mean confidence "
+        "visible %.2f, thermal %.2f, fused %.2f\n",
+        std::string(c.mode).c_str(), static_cast<unsigned long long>(c.frames),
+        static_cast<unsigned long long>(c.frames_unusable),
+        static_cast<unsigned long long>(c.frames_without_imu),
+        static_cast<double>(c.features_total) / frames, 100.0 * c.match_success_rate(),
+        c.features_total > 0
+            ? 100.0 * static_cast<double>(c.depth_total) / static_cast<double>(c.features_total)
+            : 0.0,
+        static_cast<unsigned long long>(c.static_dropped_total),
+        static_cast<unsigned long long>(c.thermal_frozen), c.mean_confidence[0],
+        c.mean_confidence[1], c.mean_confidence[2]);
+  }
+  print_visual_summary(st.estimator);
+  if (!r.published)
+    std::printf("  published           nothing (offline run, no DDS)\n");
+  else
+    std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
+                static_cast<unsigned long long>(tally.odom.load()),
+                static_cast<unsigned long long>(tally.pose),
+                static_cast<unsigned long long>(tally.status), r.config.dds.domain_id,
+                tally.failed.load() ? " (some writes failed)" : "");
+  if (r.published) {
+    std::printf("  latency             %s\n",
+                r.sinks.odom_latency().line(r.sinks.live_clock()).c_str());
+    std::printf("                      %s\n",
+                r.sinks.pose_latency().line(r.sinks.live_clock()).c_str());
+    const std::string_view mode = r.pipe.odometry_mode();
+    std::printf("  odometry            %s\n",
+                mode == "imu_thread"
+                    ? "propagated on the IMU thread from the newest optimised state"
+                : mode == "in_order"
+                    ? "propagated from the optimised states in data order (max-speed replay)"
+                    : "propagated by the fusion core after each measurement");
+  }
+  if (r.recorder != nullptr) {
+    const auto rc = r.recorder->counters();
+    std::printf("  recorded            %llu messages to %s (%.1f MB, %llu dropped)\n",
+                static_cast<unsigned long long>(rc.messages_written), r.options.record_path.c_str(),
+                static_cast<double>(rc.bytes_on_disk) / 1e6,
+                static_cast<unsigned long long>(rc.dropped));
+  }
+  if (!r.map_line.empty()) std::printf("  map                 %s\n", r.map_line.c_str());
+  if (tally.last) {
+    const NavState& s = *tally.last;
+    std::printf("  final pose          x %.3f m, y %.3f m, z %.3f m, yaw %.1f deg\n",
+                s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z(), yaw_deg(s.q_map_base));
+    std::printf("  distance travelled  %.2f m\n", tally.distance_m);
+    if (r.synthetic != nullptr) {
+      const auto truth = r.synthetic->motion().at(s.stamp - r.synthetic->motion_start());
+      std::printf("  vs known motion     position error %.3f m, heading error %.2f deg\n",
+                  (s.p_map_base_m - truth.p_map_base_m).norm(),
+                  s.q_map_base.angularDistance(truth.q_map_base) * 180.0 / M_PI);
+    }
+  } else {
+    std::printf("  final pose          none (the estimator never aligned: was the IMU static?)\n");
+    std::fflush(stdout);
+    return false;
+  }
+  std::fflush(stdout);
+  return true;
+}
+
+}  // namespace posed

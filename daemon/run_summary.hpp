@@ -1,0 +1,43 @@
+#pragma once
+// The summary a person reads at the end of a run (posed, posectl export): what each stream
+// delivered, the estimator's figures, what was published and how late, the recording, the map,
+// and the final pose.
+
+#include <string>
+
+#include "core/time.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/pose_sinks.hpp"
+#include "daemon/run_daemon.hpp"
+
+namespace posed {
+
+namespace pipeline {
+class Pipeline;
+}
+namespace drivers {
+class SyntheticImuSource;
+}
+namespace drivers::recording {
+class Recorder;
+}
+
+struct RunSummary {
+  const config::PosedConfig& config;
+  const RunOptions& options;
+  const pipeline::Pipeline& pipe;  ///< joined
+  const PoseSinks& sinks;
+  HostTime started;           ///< the process's start
+  HostTime pipeline_started;  ///< the pipeline's start (the replay's real-time factor)
+  std::string replay_streams;
+  bool has_lidar = false;
+  const drivers::recording::Recorder* recorder = nullptr;  ///< closed; null: not recording
+  std::string map_line;                                    ///< "" without --save-map
+  const drivers::SyntheticImuSource* synthetic = nullptr;  ///< the truth of a synthetic IMU
+  bool published = true;  ///< a DDS participant published (false: an offline run)
+};
+
+/// Prints it to stdout; false when there was no pose at all (the estimator never aligned).
+bool print_run_summary(const RunSummary& r);
+
+}  // namespace posed
