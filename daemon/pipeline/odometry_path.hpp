@@ -15,7 +15,6 @@
 #include "core/estimator/nav_state.hpp"
 #include "core/estimator/odometry_propagator.hpp"
 #include "core/spsc_queue.hpp"
-#include "daemon/pipeline/stage_support.hpp"
 
 namespace posed::pipeline {
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <set>
 
 #include "drivers/common/host_clock.hpp"
@@ -126,20 +127,13 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
       return ReadStatus::kEndOfStream;
     }
   }
+  // When the pending message is due on the host clock (recorded timing, scaled by the rate, or
+  // one shift shared by every stream with live stamps); none at full speed.
   std::int64_t receive_ns = pending_log_ns_;
+  std::optional<HostTime> due;
   if (config_.live_timeline) {
-    const Duration shift = config_.live_timeline->shift(pending_log_ns_, host_now());
-    receive_ns = pending_log_ns_ + shift.ns;
-    const HostTime due = HostTime::from_ns(receive_ns);
-    const HostTime now = host_now();
-    if (due > now) {
-      const Duration wait = std::min(due - now, timeout);
-      std::unique_lock lock(wait_mutex_);
-      wait_cv_.wait_for(lock, std::chrono::nanoseconds(std::max<std::int64_t>(0, wait.ns)),
-                        [&] { return stop_.load(std::memory_order_relaxed); });
-      if (stop_.load(std::memory_order_relaxed)) return ReadStatus::kEndOfStream;
-      if (host_now() < due) return ReadStatus::kTimeout;
-    }
+    receive_ns += config_.live_timeline->shift(pending_log_ns_, host_now()).ns;
+    due = HostTime::from_ns(receive_ns);
   } else if (config_.rate > 0) {
     if (!paced_) {
       paced_ = true;
@@ -148,16 +142,15 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
     }
     const auto offset_ns = static_cast<std::int64_t>(
         static_cast<double>(pending_log_ns_ - anchor_log_ns_) / config_.rate);
-    const HostTime due = anchor_host_ + Duration::from_ns(offset_ns);
-    const HostTime now = host_now();
-    if (due > now) {
-      const Duration wait = std::min(due - now, timeout);
-      std::unique_lock lock(wait_mutex_);
-      wait_cv_.wait_for(lock, std::chrono::nanoseconds(std::max<std::int64_t>(0, wait.ns)),
-                        [&] { return stop_.load(std::memory_order_relaxed); });
-      if (stop_.load(std::memory_order_relaxed)) return ReadStatus::kEndOfStream;
-      if (host_now() < due) return ReadStatus::kTimeout;
-    }
+    due = anchor_host_ + Duration::from_ns(offset_ns);
+  }
+  if (due && *due > host_now()) {
+    const Duration wait = std::min(*due - host_now(), timeout);
+    std::unique_lock lock(wait_mutex_);
+    wait_cv_.wait_for(lock, std::chrono::nanoseconds(std::max<std::int64_t>(0, wait.ns)),
+                      [&] { return stop_.load(std::memory_order_relaxed); });
+    if (stop_.load(std::memory_order_relaxed)) return ReadStatus::kEndOfStream;
+    if (host_now() < *due) return ReadStatus::kTimeout;
   }
   chunk.bytes = pending_.data;
   chunk.host_receive = HostTime::from_ns(receive_ns);

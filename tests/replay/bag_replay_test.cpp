@@ -26,6 +26,7 @@
 #include "tests/common/ros1_bag_writer.hpp"
 #include "tests/common/ros1_serialize.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/replay/recorded_poses.hpp"
 #include "tools/eval/evaluation.hpp"
 
 namespace posed::testing {
@@ -52,19 +53,7 @@ std::int64_t host_to_wall_ns(const rec::McapReader& reader) {
 
 /// A pose channel of a recording as an eval trajectory (stamps in the messages' wall time).
 eval::Trajectory trajectory(const std::string& path, const std::string& topic, bool odometry) {
-  rec::McapReader reader;
-  std::string error;
-  EXPECT_TRUE(reader.open(path, error)) << error;
-  std::map<std::int64_t, rec::ros2::StampedPose> by_stamp;
-  rec::McapMessage m;
-  while (reader.next(m)) {
-    if (m.channel->topic != topic) continue;
-    rec::ros2::StampedPose p;
-    const bool ok = odometry ? rec::ros2::decode_odometry(m.data, p)
-                             : rec::ros2::decode_pose_stamped(m.data, p);
-    EXPECT_TRUE(ok);
-    by_stamp[p.stamp.ns] = p;
-  }
+  const auto by_stamp = recorded_poses(path, topic, odometry);
   eval::Trajectory t;
   t.source = path + ":" + topic;
   for (const auto& [stamp, p] : by_stamp) {
