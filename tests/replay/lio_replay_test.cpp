@@ -77,6 +77,17 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
     ASSERT_EQ(ia->second.q_xyzw, ib->second.q_xyzw);
   }
 
+  // posectl export picks posed's poses from a recording that also holds its odometry.
+  {
+    PosedProcess exported(
+        {build_dir() + "/tools/posectl/posectl", "export", outputs[0], "--tum", dir.file("a.tum")},
+        {}, dir);
+    ASSERT_EQ(exported.wait_for_exit(60s), 0) << exported.err();
+    EXPECT_NE(exported.err().find(std::to_string(a.size()) + " poses from /posed/pose"),
+              std::string::npos)
+        << exported.err();
+  }
+
   // The poses are stamped in the recording's time base: they meet the ground truth (100 Hz)
   // within 5 ms, without any offset. ATE after the best rigid alignment.
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs;

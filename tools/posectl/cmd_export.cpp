@@ -6,6 +6,7 @@
 // keyframe poses (daemon/run_daemon.hpp, --save-map).
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -46,6 +47,9 @@ int export_map(const std::string& path, const std::string& config_path,
 
 }  // namespace
 
+/// posed's optimised poses in its recordings
+constexpr const char* kPosedPoseTopic = "/posed/pose";
+
 int run_export(int argc, char** argv) {
   CLI::App app{
       "Exports from an MCAP recording.\n  --tum: a TUM trajectory (timestamp [s], position [m], "
@@ -57,7 +61,9 @@ int run_export(int argc, char** argv) {
   std::string path, tum_path, pcd_path, topic, config_path;
   app.add_option("FILE", path, "MCAP recording")->required()->check(CLI::ExistingFile);
   app.add_option("--tum", tum_path, "TUM trajectory to write");
-  app.add_option("--topic", topic, "pose channel for --tum (needed when the file has several)");
+  app.add_option("--topic", topic,
+                 "pose channel for --tum; default: the only one, or posed's /posed/pose in a posed "
+                 "recording (which also holds /posed/odom)");
   app.add_option("--pcd", pcd_path, "map to write (PCD)");
   app.add_option("-c,--config", config_path,
                  "posed configuration for --pcd (rig, estimator); default: the built-in defaults, "
@@ -80,32 +86,47 @@ int run_export(int argc, char** argv) {
     std::fprintf(stderr, "posectl export: %s\n", error.c_str());
     return 1;
   }
-  auto kind_of = [&](const rec::McapChannelRecord& c) -> int {
-    const auto* s = reader.schema(c.schema_id);
+  // 1: PoseStamped, 2: Odometry, 0: not a pose channel
+  const auto kind_of = [](const rec::McapReader& r, const rec::McapChannelRecord& c) -> int {
+    const auto* s = r.schema(c.schema_id);
     if (s == nullptr || c.message_encoding != rec::ros2::kMessageEncoding) return 0;
     if (s->name == rec::ros2::kPoseStampedName) return 1;
     if (s->name == rec::ros2::kOdometryName) return 2;
     return 0;
   };
-  // With an intact summary the pose channels are known now; otherwise pick while scanning.
-  if (topic.empty() && reader.summary().usable()) {
+  if (topic.empty()) {
+    // The pose channels: from the summary, or, in a file cut short, by reading it through once.
+    rec::McapReader listing;
+    if (!listing.open(path, error)) {
+      std::fprintf(stderr, "posectl export: %s\n", error.c_str());
+      return 1;
+    }
+    if (!listing.summary().usable()) {
+      rec::McapMessage skipped;
+      while (listing.next(skipped)) {
+      }
+    }
     std::vector<std::string> topics;
-    for (const auto& [id, c] : reader.channels()) {
-      if (kind_of(c) != 0) topics.push_back(c.topic);
+    for (const auto& [id, c] : listing.channels()) {
+      if (kind_of(listing, c) != 0) topics.push_back(c.topic);
     }
     if (topics.empty()) {
       std::fprintf(stderr, "posectl export: %s holds no PoseStamped/Odometry channel\n",
                    path.c_str());
       return 1;
     }
-    if (topics.size() > 1) {
+    // A posed recording holds its optimised poses and its IMU-rate odometry: the poses are what
+    // a trajectory is evaluated on (--topic /posed/odom for the other).
+    const bool has_posed_poses =
+        std::find(topics.begin(), topics.end(), kPosedPoseTopic) != topics.end();
+    if (topics.size() > 1 && !has_posed_poses) {
       std::fprintf(stderr, "posectl export: %s holds several pose channels; pick one with --topic:",
                    path.c_str());
       for (const auto& t : topics) std::fprintf(stderr, " %s", t.c_str());
       std::fprintf(stderr, "\n");
       return 2;
     }
-    topic = topics.front();
+    topic = topics.size() > 1 ? std::string(kPosedPoseTopic) : topics.front();
   }
   std::FILE* out = std::fopen(tum_path.c_str(), "w");
   if (out == nullptr) {
@@ -116,9 +137,8 @@ int run_export(int argc, char** argv) {
   rec::McapMessage m;
   rec::ros2::StampedPose p;
   while (reader.next(m)) {
-    const int kind = kind_of(*m.channel);
+    const int kind = kind_of(reader, *m.channel);
     if (kind == 0) continue;
-    if (topic.empty()) topic = m.channel->topic;  // damaged file: the first pose channel
     if (m.channel->topic != topic) continue;
     const bool ok = kind == 1 ? rec::ros2::decode_pose_stamped(m.data, p)
                               : rec::ros2::decode_odometry(m.data, p);
