@@ -3,6 +3,7 @@
 #include <bit>
 #include <cstdio>
 #include <iterator>
+#include <limits>
 #include <utility>
 
 namespace posed::drivers::can {
@@ -171,7 +172,10 @@ CanImuStatus CanImuDecoder::decode(const CanFrame& frame, CanImuReading& reading
         pending_.specific_force_mps2[axis] = v;
         break;
       case ImuField::kCounter:
-        pending_.counter_us = v <= 0 ? 0 : static_cast<std::uint64_t>(v);
+        // Clamped to [0, 2^64) first: an f32 NaN/inf or a large scale would make the cast UB.
+        pending_.counter_us = !(v > 0)      ? 0
+                              : v >= 0x1p64 ? std::numeric_limits<std::uint64_t>::max()
+                                            : static_cast<std::uint64_t>(v);
         pending_.has_counter = true;
         break;
     }

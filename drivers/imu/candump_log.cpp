@@ -1,6 +1,7 @@
 #include "drivers/imu/candump_log.hpp"
 
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "drivers/common/log.hpp"
@@ -36,6 +37,10 @@ bool parse_candump_line(std::string_view line, CandumpRecord& record, std::strin
   if (i == sec_start || i >= line.size() || line[i] != '.') {
     return fail(error, line, i, "expected seconds.fraction");
   }
+  // The stamp is held in int64 nanoseconds: up to 2^63 ns, year 2262.
+  if (sec > std::numeric_limits<std::int64_t>::max() / 1'000'000'000 - 1) {
+    return fail(error, line, sec_start, "timestamp beyond 2^63 ns");
+  }
   ++i;
   std::int64_t frac_ns = 0, scale = 100'000'000;
   const std::size_t frac_start = i;
@@ -56,6 +61,11 @@ bool parse_candump_line(std::string_view line, CandumpRecord& record, std::strin
   const std::size_t if_len = i - if_start;
   if (if_len == 0 || if_len >= record.interface.size()) {
     return fail(error, line, if_start, "bad interface name");
+  }
+  // Printable ASCII only: the name is kept NUL-terminated, and a NUL or control byte in it
+  // (a binary file read as a log) would cut or garble it.
+  for (std::size_t k = if_start; k < i; ++k) {
+    if (line[k] <= ' ' || line[k] > '~') return fail(error, line, k, "bad interface name");
   }
   std::memcpy(record.interface.data(), line.data() + if_start, if_len);
   while (i < line.size() && line[i] == ' ') ++i;

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "drivers/imu/can_frame.hpp"
 #include "drivers/imu/can_imu_mapping.hpp"
@@ -84,6 +85,30 @@ TEST(Candump, RejectsMalformedLinesWithColumn) {
     std::string error;
     EXPECT_FALSE(parse_candump_line(bad, r, error)) << bad;
     EXPECT_NE(error.find("column"), std::string::npos) << bad << " -> " << error;
+  }
+}
+
+// Fuzzing (can_fuzz) found seconds that overflow the int64 nanosecond stamp (UB): refused.
+TEST(Candump, TimestampBeyondInt64NanosecondsIsRefused) {
+  EXPECT_EQ(parse_ok("(9223372035.999999) can0 123#00").stamp_ns, 9'223'372'035'999'999'000LL);
+  for (const char* bad : {"(9223372036.0) can0 123#00", "(170000010060.0) can0 123#00",
+                          "(999999999999.999999) can0 123#00"}) {
+    CandumpRecord r;
+    std::string error;
+    EXPECT_FALSE(parse_candump_line(bad, r, error)) << bad;
+    EXPECT_NE(error.find("2^63"), std::string::npos) << bad << " -> " << error;
+  }
+}
+
+// can_fuzz: an interface name with a NUL or control byte was accepted, and read back empty.
+TEST(Candump, InterfaceNameMustBePrintable) {
+  using namespace std::string_literals;
+  for (const std::string& bad :
+       {"(1.0) \0can0 123#R"s, "(1.0) ca\tn0 123#00"s, "(1.0) can\x7f 123#00"s}) {
+    CandumpRecord r;
+    std::string error;
+    EXPECT_FALSE(parse_candump_line(bad, r, error)) << bad;
+    EXPECT_NE(error.find("bad interface name"), std::string::npos) << error;
   }
 }
 
@@ -203,6 +228,34 @@ TEST(CanImuMapping, FloatFieldsInAnFdFrame) {
   EXPECT_NEAR(r.specific_force_mps2.z(), 9.81, 1e-6);
   f.extended = false;  // same number, other ID space
   EXPECT_EQ(d.decode(f, r), CanImuStatus::kIgnored);
+}
+
+// can_fuzz: an f32 counter holding NaN or inf, or a counter scaled past 2^64 us, was cast to
+// u64 (UB). The counter is clamped to [0, 2^64 - 1]; NaN reads 0.
+TEST(CanImuMapping, CounterOutOfRangeIsClampedNotCast) {
+  CanImuMapping m;
+  const ImuField axes[6] = {ImuField::kGyroX,  ImuField::kGyroY,  ImuField::kGyroZ,
+                            ImuField::kAccelX, ImuField::kAccelY, ImuField::kAccelZ};
+  for (int i = 0; i < 6; ++i) {
+    m.fields.push_back({0x100, false, axes[i], 0, FieldType::kU8, false, 1.0, 0.0});
+  }
+  m.fields.push_back({0x100, false, ImuField::kCounter, 4, FieldType::kF32, false, 1e30, 0.0});
+  m.complete_on_id = 0x100;
+  CanImuDecoder d(m);
+  CanFrame f;
+  f.id = 0x100;
+  f.len = 8;
+  const float counters[] = {std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::infinity(), 1e30f, -5.0f, 2.0f};
+  const std::uint64_t expected[] = {0, std::numeric_limits<std::uint64_t>::max(),
+                                    std::numeric_limits<std::uint64_t>::max(), 0,
+                                    std::numeric_limits<std::uint64_t>::max()};
+  for (std::size_t i = 0; i < std::size(counters); ++i) {
+    std::memcpy(f.data.data() + 4, &counters[i], 4);  // little-endian host
+    CanImuReading r;
+    ASSERT_EQ(d.decode(f, r), CanImuStatus::kSample);
+    EXPECT_EQ(r.counter_us, expected[i]) << counters[i];
+  }
 }
 
 TEST(CanImuMapping, ValidateSaysWhatIsWrong) {
