@@ -41,7 +41,9 @@ bool parse_iio_scan_type(std::string_view s, IioScanType& out) {
   if (!take(s, ">>") || !take_number(s, t.shift) || !s.empty()) return false;
   const bool storage_ok =
       t.storagebits == 8 || t.storagebits == 16 || t.storagebits == 32 || t.storagebits == 64;
-  if (!storage_ok || t.realbits == 0 || t.realbits + t.shift > t.storagebits || t.repeat == 0) {
+  // Each bound on its own: realbits + shift can wrap around 2^32. The kernel's repeat is a u8.
+  if (!storage_ok || t.realbits == 0 || t.realbits > t.storagebits ||
+      t.shift > t.storagebits - t.realbits || t.repeat == 0 || t.repeat > 255) {
     return false;
   }
   out = t;
@@ -71,20 +73,32 @@ bool layout_iio_scan(std::vector<IioScanElement> elements, IioScanLayout& out, s
   }
   std::sort(elements.begin(), elements.end(),
             [](const auto& a, const auto& b) { return a.index < b.index; });
-  std::uint32_t bytes = 0, largest = 1;
+  // 64-bit sums: a record is refused when it exceeds kMaxRecordBytes, never wrapped around.
+  std::uint64_t bytes = 0, largest = 1;
   for (std::size_t i = 0; i < elements.size(); ++i) {
     if (i > 0 && elements[i].index == elements[i - 1].index) {
       error = "scan elements " + elements[i - 1].name + " and " + elements[i].name +
               " share index " + std::to_string(elements[i].index);
       return false;
     }
-    const std::uint32_t size = elements[i].type.storagebits / 8;
+    const IioScanType& t = elements[i].type;
+    const std::uint64_t size = t.storagebits / 8;
+    if (size == 0 || t.realbits == 0 || t.realbits > t.storagebits || t.repeat == 0 ||
+        t.shift > t.storagebits - t.realbits) {
+      error = "scan element " + elements[i].name + " has an invalid type " + to_string(t);
+      return false;
+    }
     bytes = (bytes + size - 1) / size * size;  // natural alignment
-    elements[i].offset = bytes;
-    bytes += size * elements[i].type.repeat;
+    elements[i].offset = static_cast<std::uint32_t>(bytes);
+    bytes += size * t.repeat;
     largest = std::max(largest, size);
+    if (bytes > kMaxRecordBytes) {
+      error = "scan elements up to " + elements[i].name + " need " + std::to_string(bytes) +
+              " bytes per record, more than " + std::to_string(kMaxRecordBytes);
+      return false;
+    }
   }
-  out.record_bytes = (bytes + largest - 1) / largest * largest;
+  out.record_bytes = static_cast<std::uint32_t>((bytes + largest - 1) / largest * largest);
   out.elements = std::move(elements);
   return true;
 }

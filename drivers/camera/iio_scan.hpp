@@ -30,7 +30,7 @@ struct IioScanType {
 };
 
 /// Parses a sysfs scan element type; false if malformed (storage not 8/16/32/64, realbits
-/// beyond storage, shift + realbits beyond storage).
+/// beyond storage, shift + realbits beyond storage, repeat 0 or above 255).
 bool parse_iio_scan_type(std::string_view text, IioScanType& out);
 /// The canonical text of a type ("le:s16/32>>0").
 std::string to_string(const IioScanType& type);
@@ -49,8 +49,12 @@ struct IioScanLayout {
   const IioScanElement* find(std::string_view name) const;
 };
 
+/// Largest record layout_iio_scan() accepts [B]; the kernel's are tens of bytes.
+inline constexpr std::uint32_t kMaxRecordBytes = 65536;
+
 /// Sorts `elements` by index and computes offsets and the record size as the kernel does.
-/// false with `error` on an empty set or duplicate indices.
+/// false with `error` on an empty set, duplicate indices, an invalid type or a record beyond
+/// kMaxRecordBytes.
 bool layout_iio_scan(std::vector<IioScanElement> elements, IioScanLayout& out, std::string& error);
 
 /// The layout as a wire-format suffix: "<prefix>;in_accel_x:le:s16/32>>0;..." (scan order).

@@ -27,6 +27,10 @@ RealsenseImuDecoder::RealsenseImuDecoder(std::string_view wire_format, Realsense
     return;
   }
   if (!parse_iio_layout(wire_format, prefix, layout_, error_)) return;
+  if (layout_.record_bytes == 0) {  // decode() divides by it
+    error_ = "wire format '" + std::string(wire_format) + "' gives empty records";
+    return;
+  }
   const char* axes[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
     axis_[i] = layout_.find(std::string(axis_stem) + axes[i]);

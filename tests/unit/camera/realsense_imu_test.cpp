@@ -183,6 +183,42 @@ TEST(RealsenseImuDecoder, UnusableWireFormatsAreRefusedAndCounted) {
   }
 }
 
+// Found while fuzzing (realsense_fuzz): a shift of 2^32 - 1 wrapped realbits + shift past the
+// storage check (then a 2^32-bit shift, UB), and repeats whose sizes wrapped the 32-bit record
+// size to 0 (then decode() divided by zero). Both are refused with a reason.
+TEST(RealsenseImuDecoder, WrappingShiftsAndRepeatsAreRefused) {
+  IioScanType t;
+  EXPECT_FALSE(parse_iio_scan_type("le:s1/8>>4294967295", t));
+  EXPECT_FALSE(parse_iio_scan_type("le:s16/32X256>>0", t));
+  EXPECT_TRUE(parse_iio_scan_type("le:s16/32X255>>16", t));
+  std::vector<D4xxMotionSample> out(4);
+  const std::vector<std::byte> bytes(64);
+  for (const char* bad :
+       {"iio-hid-accel-3d;in_accel_x:le:s1/8>>4294967295;in_accel_y:le:s16/32>>0;"
+        "in_accel_z:le:s16/32>>0",
+        "iio-hid-accel-3d;in_accel_x:le:s16/32X1073741824>>0;in_accel_y:le:s16/32X1073741824>>0;"
+        "in_accel_z:le:s16/32X1073741824>>0;in_accel_w:le:s16/32X1073741824>>0"}) {
+    RealsenseImuDecoder d(bad);
+    EXPECT_FALSE(d.valid()) << bad;
+    EXPECT_FALSE(d.error().empty());
+    EXPECT_EQ(d.decode(bytes, out), 0u);
+  }
+  // Elements built in code are checked too: 64-bit sums, a cap on the record size.
+  std::vector<IioScanElement> e(2);
+  for (std::uint32_t i = 0; i < 2; ++i) {
+    e[i].name = "in_big" + std::to_string(i);
+    e[i].index = i;
+    ASSERT_TRUE(parse_iio_scan_type("le:u64/64X255>>0", e[i].type));
+  }
+  IioScanLayout layout;
+  std::string error;
+  ASSERT_TRUE(layout_iio_scan(e, layout, error)) << error;
+  EXPECT_EQ(layout.record_bytes, 2u * 8u * 255u);
+  e[1].type.repeat = 0x20000000;  // 8 B x 2^29 = 2^32 B: wrapped to 0 before
+  EXPECT_FALSE(layout_iio_scan(e, layout, error));
+  EXPECT_NE(error.find("bytes per record"), std::string::npos) << error;
+}
+
 /// A fake /sys/bus/iio/devices tree and /dev with FIFOs, in a temp dir.
 class FakeIio : public ::testing::Test {
  protected:
