@@ -8,6 +8,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -134,6 +136,58 @@ TEST(UnitConfinement, TheSandboxKillsACallOutsideTheFilter) {
                         source_dir() + "/systemd/posed.service", "--", "/bin/true"},
                        {}, dir);
   EXPECT_EQ(allowed.wait_for_exit(30s), 0) << allowed.err();
+}
+
+// The drop-in posectl writes from a config narrows the unit's allow-list to the lidar and the
+// DDS peers, adds AF_CAN for a CAN IMU, and systemd accepts the unit with it.
+TEST(UnitDropin, NarrowsTheAllowListToTheConfiguredLidarAndPeers) {
+  TempDir dir;
+  const std::string xml =
+      dir.write("cyclonedds.xml",
+                "<CycloneDDS><Domain Id=\"any\"><Discovery><Peers><Peer address=\"localhost\"/>"
+                "<Peer address=\"10.1.2.3\"/></Peers></Discovery></Domain></CycloneDDS>\n");
+  // The shipped CAN example (its mapping) with this test's Cyclone XML and a UDP lidar.
+  const std::string config = dir.write(
+      "posed.yaml",
+      std::regex_replace(read_file(source_dir() + "/config/imu-can-example.yaml"),
+                         std::regex("cyclonedds_config: [^\n]*"), "cyclonedds_config: " + xml) +
+          "lidar:\n  enabled: true\n  source: udp\n  address: 192.168.1.201\n");
+  PosedProcess dropin({build_dir() + "/tools/posectl/posectl", "unit-dropin", "--config", config,
+                       "--dds-peer", "192.168.7.0/24"},
+                      {}, dir);
+  ASSERT_EQ(dropin.wait_for_exit(30s), 0) << dropin.err();
+  const std::string text = dropin.out();
+  std::vector<std::string> allowed;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("IPAddressAllow=", 0) == 0) allowed.push_back(line.substr(15));
+  }
+  const std::vector<std::string> expected = {
+      "", "localhost", "multicast", "192.168.1.201", "10.1.2.3", "192.168.7.0/24"};
+  EXPECT_EQ(allowed, expected) << text;
+  EXPECT_NE(text.find("\nRestrictAddressFamilies=AF_CAN\n"), std::string::npos) << text;
+
+  // systemd takes the unit with the drop-in appended (as it merges one), and rates it no worse.
+  const std::string unit_text = read_file(source_dir() + "/systemd/posed.service");
+  const std::string merged =
+      std::regex_replace(unit_text, std::regex(R"(ExecStart=/usr/bin/posed)"),
+                         "ExecStart=/bin/true") +
+      text.substr(text.find("[Service]"));
+  TempDir unit_dir;
+  const std::string unit = unit_dir.write("posed.service", merged);
+  PosedProcess verify({"/usr/bin/systemd-analyze", "verify", "--man=no", unit}, {}, dir);
+  EXPECT_EQ(verify.wait_for_exit(30s), 0);
+  EXPECT_EQ(verify.out() + verify.err(), "");
+
+  // A lidar address that is not one is refused with the file named.
+  const std::string bad = dir.write("bad.yaml",
+                                    "lidar:\n  enabled: true\n  source: udp\n  "
+                                    "address: velodyne.local\n");
+  PosedProcess refused({build_dir() + "/tools/posectl/posectl", "unit-dropin", "--config", bad}, {},
+                       dir);
+  EXPECT_EQ(refused.wait_for_exit(30s), 2);
+  EXPECT_NE(refused.err().find("bad.yaml: lidar.address 'velodyne.local'"), std::string::npos)
+      << refused.err();
 }
 
 }  // namespace unit_confinement_test

@@ -25,6 +25,9 @@ std::span<const Command> commands() {
               run_record},
       Command{"import", "turn a pcap capture, candump log or ROS 1 bag into a posed recording",
               run_import},
+      Command{"unit-dropin",
+              "print a posed.service drop-in narrowing its IP allow-list to the config's peers",
+              run_unit_dropin},
   };
   return kCommands;
 }

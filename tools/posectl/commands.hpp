@@ -28,5 +28,6 @@ int run_export(int argc, char** argv);
 int run_record(int argc, char** argv);
 int run_replay(int argc, char** argv);
 int run_import(int argc, char** argv);
+int run_unit_dropin(int argc, char** argv);
 
 }  // namespace posed::posectl
