@@ -44,8 +44,11 @@ DecodeStatus FrameDecoder::decode(std::span<const std::byte> bytes, std::uint64_
     // stretched: its histogram (and so the gain) would be wrong.
     const std::size_t row = static_cast<std::size_t>(config_.width) * 2;
     const std::size_t stride = config_.stride_bytes != 0 ? config_.stride_bytes : row;
-    if (bytes.size() < stride * (config_.height - 1) + row ||
-        reinterpret_cast<std::uintptr_t>(bytes.data()) % 2 != 0) {
+    if (config_.width == 0 || config_.height == 0 || stride < row || stride % 2 != 0) {
+      // As convert_frame refuses them; an odd stride would also misalign every other row.
+      s = ConvertStatus::kBadGeometry;
+    } else if (bytes.size() < stride * (config_.height - 1) + row ||
+               reinterpret_cast<std::uintptr_t>(bytes.data()) % 2 != 0) {
       s = ConvertStatus::kDecodeError;
     } else {
       agc_->apply(reinterpret_cast<const std::uint16_t*>(bytes.data()),

@@ -105,5 +105,27 @@ TEST(FrameDecoder, Y16ThroughAgcAndShortY16Dropped) {
   EXPECT_EQ(d.decode(bytes, 7, tiny, short_img), DecodeStatus::kPoolTooSmall);
 }
 
+// camera_frame_fuzz: through AGC, a zero width or height decoded to an "ok" empty Image, and an
+// odd source stride misaligned the 16-bit loads (UB). Both are bad geometry now, as elsewhere.
+TEST(FrameDecoder, Y16AgcRefusesEmptyGeometryAndOddStrides) {
+  std::vector<std::byte> bytes(64);
+  PayloadPool pool(2, 64);
+  const std::uint32_t cases[][3] = {{0, 2, 0}, {4, 0, 0}, {4, 2, 9}, {4, 2, 6}};  // w, h, stride
+  for (const auto& [w, h, stride] : cases) {
+    FrameDecoderConfig cfg;
+    cfg.format = WireFormat::kY16;
+    cfg.width = w;
+    cfg.height = h;
+    cfg.stride_bytes = stride;
+    cfg.y16_agc_to_mono8 = true;
+    FrameDecoder d(cfg);
+    Image img;
+    EXPECT_EQ(d.decode(bytes, 1, pool, img), DecodeStatus::kBadFrame)
+        << w << "x" << h << "/" << stride;
+    EXPECT_FALSE(img.pixels.valid());
+    EXPECT_EQ(d.counters().bad, 1u);
+  }
+}
+
 }  // namespace
 }  // namespace posed::drivers::camera
