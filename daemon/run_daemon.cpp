@@ -33,6 +33,13 @@
 namespace posed {
 namespace {
 
+/// The config's dds.security as the participant takes it (the loader already refused half of it).
+dds::DdsSecurityFiles dds_security_files(const config::DdsSecuritySection& s) {
+  if (!s.enclave.empty()) return dds::DdsSecurityFiles::from_enclave(s.enclave);
+  return {s.identity_ca,    s.certificate, s.private_key,
+          s.permissions_ca, s.governance,  s.permissions};
+}
+
 /// Writes the map and keyframes the fusion core kept; false (logged) when there is none or a
 /// file cannot be written. `line` gets the summary line.
 bool save_map(const pipeline::Pipeline& pipe, const std::string& map_path, HostToWall to_wall,
@@ -95,6 +102,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds_config.map_frame = config.dds.map_frame;
   dds_config.base_frame = config.dds.base_frame;
   dds_config.cyclonedds_xml_path = config.dds.cyclonedds_config;
+  dds_config.security = dds_security_files(config.dds.security);
   std::string error;
   std::unique_ptr<dds::Publisher> publisher;
   if (options.publish_dds) publisher = dds::Publisher::create(dds_config, error);
@@ -250,10 +258,9 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   if (!options.map_path.empty() && !save_map(pipe, options.map_path, to_wall, map_line))
     exit_code = 1;
 
-  const RunSummary summary{config,         options,         pipe,
-                           sinks,          started,         pipeline_started,
-                           replay_streams, built_has_lidar, recorder.get(),
-                           map_line,       synthetic,       publisher != nullptr};
+  const RunSummary summary{config,         options,          pipe,           sinks,
+                           started,        pipeline_started, replay_streams, built_has_lidar,
+                           recorder.get(), map_line,         synthetic,      publisher != nullptr};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

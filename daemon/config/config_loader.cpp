@@ -519,8 +519,40 @@ class Loader {
   std::map<std::string, std::pair<int, int>> places_;
 };
 
+/// DDS Security is all or nothing: an enclave, or all six files; half a configuration would
+/// start posed unprotected or not at all, so it stops start-up naming what is missing.
+void check_dds_security(const DdsSecuritySection& s, std::string_view file, const Loader& loader,
+                        std::vector<ConfigError>& errors) {
+  const std::pair<const char*, const std::string*> files[] = {
+      {"dds.security.identity_ca", &s.identity_ca},
+      {"dds.security.certificate", &s.certificate},
+      {"dds.security.private_key", &s.private_key},
+      {"dds.security.permissions_ca", &s.permissions_ca},
+      {"dds.security.governance", &s.governance},
+      {"dds.security.permissions", &s.permissions}};
+  std::string set, missing;
+  const char* first_set = nullptr;
+  for (const auto& [key, value] : files) {
+    std::string& list = value->empty() ? missing : set;
+    list += std::string(list.empty() ? "" : ", ") + key;
+    if (!value->empty() && first_set == nullptr) first_set = key;
+  }
+  if (!s.enclave.empty() && !set.empty()) {
+    const auto [line, column] = loader.place_of("dds.security.enclave");
+    errors.push_back(
+        {std::string(file), line, column, "dds.security.enclave",
+         "give either an enclave directory or the six files, not both (also set: " + set + ")"});
+  } else if (s.enclave.empty() && !set.empty() && !missing.empty()) {
+    const auto [line, column] = loader.place_of(first_set);
+    errors.push_back({std::string(file), line, column, "dds.security",
+                      "half-configured: " + set + " set but " + missing +
+                          " missing; DDS Security needs all six (or dds.security.enclave)"});
+  }
+}
+
 void check_cross_field(const PosedConfig& c, std::string_view file, const Loader& loader,
                        std::vector<ConfigError>& errors) {
+  check_dds_security(c.dds.security, file, loader, errors);
   if (c.lidar.min_range_m >= c.lidar.max_range_m) {
     errors.push_back(
         {std::string(file), 0, 0, "lidar.min_range_m", "must be below lidar.max_range_m"});

@@ -17,12 +17,25 @@ using Transform4 = std::array<double, 16>;
 /// A 3x3 rotation, row-major.
 using Rotation3 = std::array<double, 9>;
 
+/// DDS Security (docs/security.md): either an SROS2 enclave directory or the six files; none of
+/// them: plain DDS.
+struct DdsSecuritySection {
+  std::string enclave;  ///< SROS2 enclave directory (…/enclaves/posed) holding the six files
+  std::string identity_ca;
+  std::string certificate;
+  std::string private_key;
+  std::string permissions_ca;
+  std::string governance;
+  std::string permissions;
+};
+
 struct DdsSection {
   int domain_id = 0;
   std::string map_frame;
   std::string base_frame;
   /// Cyclone DDS XML file; empty = CYCLONEDDS_URI or Cyclone's built-in default
   std::string cyclonedds_config;
+  DdsSecuritySection security;
 };
 
 struct PublishSection {

@@ -193,6 +193,21 @@ struct StatusMessage {
   std::array<TopicLatencyMessage, 2> latency{};
 };
 
+/// DDS Security (OMG DDS Security 1.1 with Cyclone DDS's builtin plugins): the six files of a
+/// participant's identity and permissions, as SROS2 names them in an enclave directory. All empty:
+/// plain DDS.
+struct DdsSecurityFiles {
+  std::string identity_ca;           ///< identity_ca.cert.pem: CA that signed every identity
+  std::string identity_certificate;  ///< cert.pem: this participant's certificate
+  std::string private_key;           ///< key.pem: its private key
+  std::string permissions_ca;        ///< permissions_ca.cert.pem: CA that signed the documents
+  std::string governance;            ///< governance.p7s: the domain's protection rules, signed
+  std::string permissions;           ///< permissions.p7s: what this participant may do, signed
+  bool enabled() const { return !identity_certificate.empty(); }
+  /// The files of SROS2's enclave directory `dir` (…/enclaves/NAME).
+  static DdsSecurityFiles from_enclave(const std::string& dir);
+};
+
 /// Where and how posed talks DDS (the `dds:` section of the daemon config).
 struct DdsConfig {
   /// DDS domain (ROS_DOMAIN_ID) [-]
@@ -203,6 +218,8 @@ struct DdsConfig {
   std::string base_frame = "base_link";
   /// Cyclone XML file used to create the domain; empty: CYCLONEDDS_URI or Cyclone's default.
   std::string cyclonedds_xml_path;
+  /// DDS Security; empty files: none
+  DdsSecurityFiles security;
 };
 
 }  // namespace posed::dds

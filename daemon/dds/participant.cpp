@@ -97,17 +97,69 @@ const dds_topic_descriptor_t& descriptor(Topic topic) {
   return nav_msgs_msg_dds__Odometry__desc;
 }
 
+/// The participant QoS that turns on Cyclone's builtin DDS Security plugins (authentication,
+/// access control, cryptography; Debian's libddsc0debian ships them and libddsc finds them by
+/// their default names), or nullptr for plain DDS. Every file must be readable now: a typo
+/// fails at start-up, naming the key, not as a handshake that silently never completes.
+dds_qos_t* security_qos(const DdsSecurityFiles& files, std::string& error) {
+  if (!files.enabled()) return nullptr;
+  const std::pair<const char*, const std::string*> properties[] = {
+      {"dds.sec.auth.identity_ca", &files.identity_ca},
+      {"dds.sec.auth.identity_certificate", &files.identity_certificate},
+      {"dds.sec.auth.private_key", &files.private_key},
+      {"dds.sec.access.permissions_ca", &files.permissions_ca},
+      {"dds.sec.access.governance", &files.governance},
+      {"dds.sec.access.permissions", &files.permissions},
+  };
+  for (const auto& [property, path] : properties) {
+    std::ifstream in(*path);
+    if (path->empty() || !in) {
+      error = std::string("DDS Security: ") + property + " " +
+              (path->empty() ? std::string("is not set")
+                             : *path + ": cannot read: " + std::strerror(errno));
+      return nullptr;
+    }
+  }
+  dds_qos_t* qos = dds_create_qos();
+  for (const auto& [property, path] : properties) {
+    dds_qset_prop(qos, property, ("file:" + *path).c_str());
+  }
+  // The plugins by their default names: libddsc looks for lib<name>.so where its package put them.
+  const char* plugins[][4] = {
+      {"auth", "dds_security_auth", "init_authentication", "finalize_authentication"},
+      {"crypto", "dds_security_crypto", "init_crypto", "finalize_crypto"},
+      {"access", "dds_security_ac", "init_access_control", "finalize_access_control"}};
+  for (const auto& [kind, library, init, finalize] : plugins) {
+    const std::string prefix = std::string("dds.sec.") + kind + ".library.";
+    dds_qset_prop(qos, (prefix + "path").c_str(), library);
+    dds_qset_prop(qos, (prefix + "init").c_str(), init);
+    dds_qset_prop(qos, (prefix + "finalize").c_str(), finalize);
+  }
+  return qos;
+}
+
 }  // namespace
 
 std::unique_ptr<Participant> Participant::open(const DdsConfig& config, std::string& error) {
+  dds_qos_t* qos = security_qos(config.security, error);
+  if (config.security.enabled() && qos == nullptr) return nullptr;
   const bool from_file = !config.cyclonedds_xml_path.empty();
-  if (from_file && !acquire_domain(config, error)) return nullptr;
-  const dds_entity_t participant = dds_create_participant(config.domain_id, nullptr, nullptr);
+  if (from_file && !acquire_domain(config, error)) {
+    if (qos != nullptr) dds_delete_qos(qos);
+    return nullptr;
+  }
+  const dds_entity_t participant = dds_create_participant(config.domain_id, qos, nullptr);
+  if (qos != nullptr) dds_delete_qos(qos);
   if (participant < 0) {
     error = "DDS participant on domain " + std::to_string(config.domain_id) + ": " +
             dds_strretcode(participant);
     error += from_file ? " (cyclonedds config " + config.cyclonedds_xml_path + ")"
                        : " (config from CYCLONEDDS_URI or Cyclone's default)";
+    if (config.security.enabled()) {
+      error += "; DDS Security with " + config.security.identity_certificate +
+               " (Cyclone logged the reason above: e.g. a file the CA did not sign, a domain the "
+               "governance does not name, or permissions for another subject)";
+    }
     if (from_file) release_domain(config.domain_id);
     return nullptr;
   }
@@ -149,3 +201,13 @@ std::string describe_error(std::string_view what, dds_return_t rc) {
 }
 
 }  // namespace posed::dds::detail
+
+namespace posed::dds {
+
+DdsSecurityFiles DdsSecurityFiles::from_enclave(const std::string& dir) {
+  const std::string d = dir.empty() || dir.back() == '/' ? dir : dir + "/";
+  return {d + "identity_ca.cert.pem",    d + "cert.pem",       d + "key.pem",
+          d + "permissions_ca.cert.pem", d + "governance.p7s", d + "permissions.p7s"};
+}
+
+}  // namespace posed::dds

@@ -18,7 +18,9 @@ std::span<const Benchmark> benchmarks() {
                 bench_sync},
       Benchmark{"velodyne", "Velodyne decode rate and loopback UDP receive at 15k packets/s",
                 bench_velodyne},
-      Benchmark{"dds", "DDS odom 400 Hz publish -> receive latency, two participants, loopback",
+      Benchmark{"dds",
+                "DDS odom 400 Hz publish -> receive latency and CPU, plain and DDS Security, two "
+                "processes",
                 bench_dds},
       Benchmark{"camera", "Camera decode per frame: YUYV->BGR, Z16, Y16 AGC, MJPEG (one core)",
                 bench_camera},

@@ -343,6 +343,7 @@ int run_echo(int argc, char** argv) {
   std::uint32_t domain = 0;
   std::string cyclone_config;
   std::string tum_path;
+  std::string enclave;
   app.add_option("topic", topic_arg,
                  "odom, pose, status, or the full DDS name (rt/posed/odom) or ROS name")
       ->capture_default_str();
@@ -360,6 +361,10 @@ int run_echo(int argc, char** argv) {
   app.add_option("--tum", tum_path,
                  "write odom/pose samples to this file as a TUM trajectory (stamp [s] x y z qx qy "
                  "qz qw) instead of printing them; for `posectl eval`");
+  app.add_option("--enclave", enclave,
+                 "DDS Security: an SROS2 enclave directory allowed to read posed's topics "
+                 "(posectl security init DIR makes DIR/enclaves/posectl)")
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(app, argc, argv);
 
   dds::Topic topic = dds::Topic::kOdom;
@@ -388,6 +393,7 @@ int run_echo(int argc, char** argv) {
   dds::DdsConfig config;
   config.domain_id = domain;
   config.cyclonedds_xml_path = cyclone_config;
+  if (!enclave.empty()) config.security = dds::DdsSecurityFiles::from_enclave(enclave);
   std::string error;
   const std::array topics = {topic};
   auto subscriber = dds::Subscriber::create(config, topics, error);

@@ -28,6 +28,8 @@ std::span<const Command> commands() {
       Command{"unit-dropin",
               "print a posed.service drop-in narrowing its IP allow-list to the config's peers",
               run_unit_dropin},
+      Command{"security", "make a DDS Security keystore (CA, governance, enclaves) for posed",
+              run_security},
   };
   return kCommands;
 }

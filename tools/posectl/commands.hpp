@@ -29,5 +29,6 @@ int run_record(int argc, char** argv);
 int run_replay(int argc, char** argv);
 int run_import(int argc, char** argv);
 int run_unit_dropin(int argc, char** argv);
+int run_security(int argc, char** argv);
 
 }  // namespace posed::posectl
