@@ -35,12 +35,18 @@ bool print_run_summary(const RunSummary& r) {
       std::snprintf(undecodable, sizeof undecodable, " (%llu with no decoder configured)",
                     static_cast<unsigned long long>(s.undecodable));
     }
+    // Refused chunks (another sender, oversized) never reached a decoder: said apart too.
+    char refused[64] = "";
+    if (s.refused > 0) {
+      std::snprintf(refused, sizeof refused, ", %llu refused (wrong sender or size)",
+                    static_cast<unsigned long long>(s.refused));
+    }
     std::printf(
-        "  %-19s %llu decoded (%.1f Hz mean), %llu malformed%s, %llu dropped; clock %s, "
+        "  %-19s %llu decoded (%.1f Hz mean), %llu malformed%s%s, %llu dropped; clock %s, "
         "offset %.3f ms, drift %.1f ppm\n",
         s.name.c_str(), static_cast<unsigned long long>(s.decoded),
         run_s > 0 ? static_cast<double>(s.decoded) / run_s : 0.0,
-        static_cast<unsigned long long>(s.malformed), undecodable,
+        static_cast<unsigned long long>(s.malformed), undecodable, refused,
         static_cast<unsigned long long>(s.dropped), s.clock_state.c_str(),
         static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
   }

@@ -294,13 +294,13 @@ PipelineStatus Pipeline::status() const {
 
   StreamStatus imu;
   imu.name = "imu";
-  fill_stream_status(imu, imu_counters_, now, sources_.imu->live());
+  fill_stream_status(imu, imu_counters_, *sources_.imu, now);
   st.streams.push_back(std::move(imu));
 
   if (sources_.lidar) {
     StreamStatus lidar;
     lidar.name = "lidar";
-    fill_stream_status(lidar, lidar_counters_, now, sources_.lidar->live());
+    fill_stream_status(lidar, lidar_counters_, *sources_.lidar, now);
     st.streams.push_back(std::move(lidar));
     st.lidar_scans = scan_counters_->scans.load();
     st.lidar_points = scan_counters_->points.load();
@@ -310,7 +310,7 @@ PipelineStatus Pipeline::status() const {
     if (!sources_.camera(s)) continue;
     StreamStatus camera;
     camera.name = std::string(to_string(s));
-    fill_stream_status(camera, camera_counters_[index_of(s)], now, sources_.camera(s)->live());
+    fill_stream_status(camera, camera_counters_[index_of(s)], *sources_.camera(s), now);
     st.streams.push_back(std::move(camera));
     st.camera_frames_fused[index_of(s)] = fusion_counters_->frames_fused[index_of(s)].load();
   }

@@ -14,8 +14,11 @@ namespace posed::pipeline {
 /// Per-stream figures.
 struct StreamStatus {
   std::string name;
-  double rate_hz = 0;           ///< decoded per second between status messages (publisher only)
-  std::uint64_t received = 0;   ///< chunks read from the Source
+  double rate_hz = 0;          ///< decoded per second between status messages (publisher only)
+  std::uint64_t received = 0;  ///< chunks read from the Source
+  /// chunks the Source refused before decoding: datagrams from another sender than the
+  /// configured sensor, oversized datagrams
+  std::uint64_t refused = 0;
   std::uint64_t decoded = 0;    ///< measurements decoded
   std::uint64_t dropped = 0;    ///< measurements dropped by the queue policy
   std::uint64_t malformed = 0;  ///< frames rejected by the decoder (CRC, truncation, unknown)

@@ -17,9 +17,11 @@ ClockSyncStatus StreamCounters::clock() const {
   return clock_;
 }
 
-void fill_stream_status(StreamStatus& out, const StreamCounters& counters, HostTime now,
-                        bool live) {
+void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
+                        const drivers::Source& source, HostTime now) {
+  const bool live = source.live();
   out.received = counters.received.load(std::memory_order_relaxed);
+  out.refused = source.counters().rejected;
   out.decoded = counters.decoded.load(std::memory_order_relaxed);
   out.undecodable = counters.undecodable.load(std::memory_order_relaxed);
   out.malformed = counters.malformed.load(std::memory_order_relaxed) + out.undecodable;

@@ -80,9 +80,11 @@ struct StreamCounters {
   ClockSyncStatus clock_;
 };
 
-/// Fills `out` from the counters; `live`: arrival times are on this host's clock, so a second of
-/// silence means the stream is lost whatever the clock estimate said last.
-void fill_stream_status(StreamStatus& out, const StreamCounters& counters, HostTime now, bool live);
+/// Fills `out` from the stage's counters and its Source's. A live Source's arrival times are on
+/// this host's clock, so a second of silence means the stream is lost whatever the clock
+/// estimate said last.
+void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
+                        const drivers::Source& source, HostTime now);
 
 /// The bookkeeping every source stage does around Source::read(): heartbeat, the device lost and
 /// back (logged once per transition), the received count, and chunks of a wire format the stage

@@ -10,8 +10,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdlib>
+#include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "daemon/dds/subscriber.hpp"
@@ -22,11 +25,28 @@
 
 namespace posed::testing::hil_helpers {
 
-/// Drives a live posed (started as `posed_prefix` + posed's own arguments, so a test can run it
-/// under a sandbox) with `posectl replay` of a `duration_s` simulated street drive over UDP and a
-/// pty, and checks that every packet arrived and the poses follow the ground truth.
-inline void run_hil_drive(const std::vector<std::string>& posed_prefix, int duration_s) {
+struct HilDrive {
+  /// started before posed's own arguments, so a test can run it under a sandbox
+  std::vector<std::string> posed_prefix;
+  /// of the simulated street drive [s]
+  int duration_s = 15;
+  /// run on a thread of its own while the replay plays, with posed's lidar data port, until
+  /// `stop` is set (a test's extra traffic)
+  std::function<void(std::uint16_t data_port, const std::atomic<bool>& stop)> alongside;
+};
+
+/// What the drive's two processes printed at exit.
+struct HilDriveResult {
+  std::string posed_summary;
+  std::string replay_summary;
+};
+
+/// Drives a live posed with `posectl replay` of a simulated street drive over UDP and a pty, and
+/// checks that every packet arrived and the poses follow the ground truth.
+inline void run_hil_drive(const HilDrive& drive, HilDriveResult* result_out = nullptr) {
   using namespace std::chrono_literals;
+  const std::vector<std::string>& posed_prefix = drive.posed_prefix;
+  const int duration_s = drive.duration_s;
   TempDir dir;
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   const std::string recording = dir.file("street.mcap");
@@ -74,6 +94,11 @@ inline void run_hil_drive(const std::vector<std::string>& posed_prefix, int dura
        "127.0.0.1:" + std::to_string(data_port) + "," + std::to_string(position_port), "--pty",
        device, "--wait-reader", "30"},
       {}, replay_dir);
+  std::atomic<bool> stop_alongside{false};
+  std::thread alongside;
+  if (drive.alongside) {
+    alongside = std::thread([&] { drive.alongside(data_port, stop_alongside); });
+  }
   std::vector<dds::Received<dds::PoseMessage>> poses;
   std::optional<int> replay_exit;
   const auto deadline = std::chrono::steady_clock::now() + 90s;
@@ -84,6 +109,8 @@ inline void run_hil_drive(const std::vector<std::string>& posed_prefix, int dura
     reader->take_pose(poses);
     replay_exit = replay.wait_for_exit(1ms);  // looks once: 0 ms would not look at all
   }
+  stop_alongside = true;
+  if (alongside.joinable()) alongside.join();
   ASSERT_EQ(replay_exit.value_or(-2), 0) << replay.err() << replay.out();
   // The last scans are still in the estimator; let them out, then stop posed as systemd would.
   for (int i = 0; i < 10; ++i) {
@@ -102,6 +129,7 @@ inline void run_hil_drive(const std::vector<std::string>& posed_prefix, int dura
   EXPECT_GT(number_after(summary, "pty"), 145 * duration_s) << summary;  // 150 Hz frames
   EXPECT_NE(summary.find("0 B discarded without a reader"), std::string::npos) << summary;
   const std::string posed_summary = posed.out();
+  if (result_out != nullptr) *result_out = {posed_summary, summary};
   EXPECT_EQ(number_after(posed_summary, "  lidar               "), data_packets) << posed_summary;
   EXPECT_GT(number_after(posed_summary, "  imu                 "), 145 * duration_s)
       << posed_summary;
