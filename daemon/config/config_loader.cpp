@@ -605,13 +605,18 @@ std::string LoadResult::error_text() const {
 }
 
 PosedConfig default_config() {
-  PosedConfig config;
-  std::vector<ConfigError> errors;
-  Loader loader("<schema defaults>", config, errors);
-  for (const auto& field : schema())
-    loader.apply(field, YAML::Load(std::string(field.default_yaml)));
-  // A default that fails its own validation is a programming error; the unit test checks for it.
-  return config;
+  // Parsed once: ~150 YAML documents per load otherwise, which made every config load (and the
+  // config fuzzer's every input) pay for the schema rather than for the file.
+  static const PosedConfig defaults = [] {
+    PosedConfig config;
+    std::vector<ConfigError> errors;
+    Loader loader("<schema defaults>", config, errors);
+    for (const auto& field : schema())
+      loader.apply(field, YAML::Load(std::string(field.default_yaml)));
+    // A default that fails its own validation is a programming error; the unit test checks it.
+    return config;
+  }();
+  return defaults;
 }
 
 LoadResult load_config_text(std::string_view yaml_text, std::string_view name) {
