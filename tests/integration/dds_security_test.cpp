@@ -3,7 +3,8 @@
 // authorised "posectl" enclave receives; a participant without security, one with a certificate
 // from another CA, and one authenticated by the right CA but without read permission get nothing,
 // and the first two do not even discover the writer (matched publishers 0: discovery is
-// encrypted). A half-configured dds.security stops posed at start-up with file, line and key.
+// encrypted); a reader's enclave cannot write posed's topics. A half-configured dds.security stops
+// posed at start-up with file, line and key.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/dds/publisher.hpp"
 #include "tests/integration/posed_process.hpp"
 
 namespace posed::testing {
@@ -88,6 +90,27 @@ TEST(DdsSecurity, OnlyTheAuthorisedReaderHearsPosed) {
 
   posed.signal(SIGTERM);
   EXPECT_EQ(posed.wait_for_exit(10s), 0) << posed.err();
+}
+
+// A forger holding a reader's enclave (authenticated by posed's CA, permitted to subscribe only)
+// cannot even create a writer for rt/posed/odom, so a controller never hears it.
+TEST(DdsSecurity, AReadersEnclaveCannotWritePosedsTopics) {
+  TempDir dir;
+  init_keystore(dir, "keystore");
+  dds::DdsConfig forger;
+  forger.domain_id = static_cast<std::uint32_t>(test_domain());
+  forger.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  forger.security = dds::DdsSecurityFiles::from_enclave(dir.file("keystore") + "/enclaves/posectl");
+  std::string error;
+  EXPECT_EQ(dds::Publisher::create(forger, error), nullptr);
+  EXPECT_NE(error.find("rt/posed/"), std::string::npos) << error;
+  EXPECT_NE(error.find("Not Allowed By Security"), std::string::npos) << error;
+
+  // The same with posed's enclave is allowed: the refusal is the permissions', not a set-up error.
+  dds::DdsConfig publisher = forger;
+  publisher.security =
+      dds::DdsSecurityFiles::from_enclave(dir.file("keystore") + "/enclaves/posed");
+  EXPECT_NE(dds::Publisher::create(publisher, error), nullptr) << error;
 }
 
 TEST(DdsSecurity, HalfAConfigurationOrAMissingFileStopsStartUp) {

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <tuple>
 
 namespace posed::posectl {
 namespace {
@@ -270,10 +271,21 @@ bool create_keystore(const KeystoreSpec& spec, std::string& error) {
       return false;
     }
   }
-  // One CA serves as both (SROS2 links the two names to ca.cert.pem the same way).
+  // One CA serves as both, under the names SROS2's tools look for: symbolic links to ca.*.pem,
+  // as `ros2 security create_keystore` makes them.
   const std::string ca_pem = cert_pem(ca_cert.get());
-  for (const char* name : {"identity_ca.cert.pem", "permissions_ca.cert.pem"}) {
-    if (!write_text(dir / "public" / name, ca_pem, error)) return false;
+  for (const auto& [folder, link, target] :
+       {std::tuple{"public", "identity_ca.cert.pem", "ca.cert.pem"},
+        std::tuple{"public", "permissions_ca.cert.pem", "ca.cert.pem"},
+        std::tuple{"private", "identity_ca.key.pem", "ca.key.pem"},
+        std::tuple{"private", "permissions_ca.key.pem", "ca.key.pem"}}) {
+    const fs::path path = dir / folder / link;
+    fs::remove(path, ec);
+    fs::create_symlink(target, path, ec);
+    if (ec) {
+      error = path.string() + ": " + ec.message();
+      return false;
+    }
   }
 
   std::string governance_p7s;
