@@ -106,6 +106,9 @@ class PoseSinks {
   void state(const NavState& s);
   /// rt/posed/status, and the line for systemd's STATUS=.
   void status(const pipeline::PipelineStatus& st);
+  /// rt/tf_static: base_link -> lidar, camera and thermal frames from the configured
+  /// extrinsics. Once at start (transient-local: later readers get it too).
+  void static_transforms();
 
   /// The last status line ("starting" before the first status); safe from any thread.
   std::string status_line() const;
@@ -123,6 +126,9 @@ class PoseSinks {
   bool live_clock_;
   Duration pose_period_;
   std::uint64_t odom_index_ = 0;
+  HostTime next_tf_stamp_;
+  /// rt/tf with `s` as odom -> base_link (and map -> odom identity), rate-limited.
+  void tf(const NavState& s, WallTime stamp);
   PublishTally tally_;
   TopicLatency odom_latency_{"rt/posed/odom", {}, {}};
   TopicLatency pose_latency_{"rt/posed/pose", {}, {}};

@@ -103,6 +103,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds_config.base_frame = config.dds.base_frame;
   dds_config.cyclonedds_xml_path = config.dds.cyclonedds_config;
   dds_config.security = dds_security_files(config.dds.security);
+  dds_config.tf = config.publish.tf;
   std::string error;
   std::unique_ptr<dds::Publisher> publisher;
   if (options.publish_dds) publisher = dds::Publisher::create(dds_config, error);
@@ -158,6 +159,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   // recording's, and how late a message is cannot be told from them.
   PoseSinks sinks(config, publisher.get(), recorder.get(), to_wall, started,
                   !replaying || options.replay.live_stamps);
+  sinks.static_transforms();
   pipeline::PipelineOutputs outputs;
   outputs.keep_map = !options.map_path.empty();
   outputs.on_odom = [&sinks](const NavState& s) { sinks.odom(s); };

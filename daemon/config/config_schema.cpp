@@ -22,6 +22,16 @@ const Field kSchema[] = {
     F("dds.map_frame", dds.map_frame, "map", "", 0, 0, "", "frame_id of published poses"),
     F("dds.base_frame", dds.base_frame, "base_link", "", 0, 0, "",
       "child_frame_id of published poses (the IMU frame)"),
+    F("dds.odom_frame", dds.odom_frame, "odom", "", 0, 0, "",
+      "REP-105 odom frame: rt/tf carries map -> odom (identity until a map correction) -> base"),
+    F("dds.lidar_frame", dds.lidar_frame, "velodyne", "", 0, 0, "",
+      "frame of the lidar in rt/tf_static (extrinsics.T_imu_lidar), as the Velodyne driver names "
+      "it"),
+    F("dds.camera_frame", dds.camera_frame, "camera_color_optical_frame", "", 0, 0, "",
+      "frame of the colour camera in rt/tf_static (extrinsics.T_imu_cam), as realsense-ros names "
+      "it"),
+    F("dds.thermal_frame", dds.thermal_frame, "thermal_optical_frame", "", 0, 0, "",
+      "frame of the thermal camera in rt/tf_static (extrinsics.T_imu_cam * T_cam_thermal)"),
     P("dds.cyclonedds_config", dds.cyclonedds_config,
       "Cyclone DDS XML file; empty uses CYCLONEDDS_URI or Cyclone's default"),
     P("dds.security.enclave", dds.security.enclave,
@@ -52,6 +62,11 @@ const Field kSchema[] = {
       "rt/posed/pose rate while the estimator is strapdown"),
     F("publish.status_rate_hz", publish.status_rate_hz, "1", "Hz", 0.1, 100, "",
       "rt/posed/status rate"),
+    F("publish.tf", publish.tf, "true", "", 0, 0, "",
+      "rt/tf (map -> odom -> base_link with each pose, off the odometry's thread) and "
+      "rt/tf_static (base_link -> lidar, camera, thermal from the extrinsics)"),
+    F("publish.tf_max_rate_hz", publish.tf_max_rate_hz, "0", "Hz", 0, 1000, "",
+      "at most this many rt/tf messages per second; 0: one with every rt/posed/pose"),
 
     F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial|can",
       "where IMU samples come from: the synthetic circle, the A9 over serial, or an IMU on a "

@@ -33,6 +33,10 @@ struct DdsSection {
   int domain_id = 0;
   std::string map_frame;
   std::string base_frame;
+  std::string odom_frame;     ///< REP-105's odom frame (rt/tf: map -> odom -> base_link)
+  std::string lidar_frame;    ///< rt/tf_static child of base_link: T_imu_lidar
+  std::string camera_frame;   ///< rt/tf_static child of base_link: T_imu_cam
+  std::string thermal_frame;  ///< rt/tf_static child of base_link: T_imu_cam * T_cam_thermal
   /// Cyclone DDS XML file; empty = CYCLONEDDS_URI or Cyclone's built-in default
   std::string cyclonedds_config;
   DdsSecuritySection security;
@@ -46,6 +50,9 @@ struct PublishSection {
   double odom_blend_s = 0.1;    ///< a correction to odometry is spread over this long [s]
   double pose_rate_hz = 10.0;   ///< rt/posed/pose rate while the estimator is strapdown [Hz]
   double status_rate_hz = 1.0;  ///< rt/posed/status rate [Hz]
+  /// rt/tf (map -> odom -> base_link, with each pose) and rt/tf_static (base_link -> sensors)
+  bool tf = true;
+  double tf_max_rate_hz = 0;  ///< at most this many rt/tf messages per second; 0: every pose [Hz]
 };
 
 struct ImuSection {

@@ -144,6 +144,41 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
   out.streams._release = false;  // the buffer belongs to the caller, not to Cyclone
 }
 
+void fill_tf(const TfMessage& msg, tf2_msgs_msg_dds__TFMessage_& out,
+             std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms) {
+  if (transforms.size() < msg.transforms.size()) transforms.resize(msg.transforms.size());
+  for (std::size_t i = 0; i < msg.transforms.size(); ++i) {
+    const TransformMessage& t = msg.transforms[i];
+    geometry_msgs_msg_dds__TransformStamped_& d = transforms[i];
+    d.header.stamp = to_ros_time(t.stamp);
+    d.header.frame_id = c_str(t.parent_frame);
+    d.child_frame_id = c_str(t.child_frame);
+    d.transform.translation = {t.p_parent_child_m.x(), t.p_parent_child_m.y(),
+                               t.p_parent_child_m.z()};
+    d.transform.rotation = to_quaternion(t.q_parent_child);
+  }
+  out.transforms._buffer = transforms.data();
+  out.transforms._length = static_cast<std::uint32_t>(msg.transforms.size());
+  out.transforms._maximum = static_cast<std::uint32_t>(transforms.size());
+  out.transforms._release = false;  // the buffer belongs to the caller, not to Cyclone
+}
+
+TfMessage to_plain(const tf2_msgs_msg_dds__TFMessage_& in) {
+  TfMessage msg;
+  for (std::uint32_t i = 0; i < in.transforms._length; ++i) {
+    const geometry_msgs_msg_dds__TransformStamped_& s = in.transforms._buffer[i];
+    TransformMessage t;
+    t.stamp = from_ros_time(s.header.stamp);
+    t.parent_frame = to_string(s.header.frame_id);
+    t.child_frame = to_string(s.child_frame_id);
+    t.p_parent_child_m = {s.transform.translation.x, s.transform.translation.y,
+                          s.transform.translation.z};
+    t.q_parent_child = from_quaternion(s.transform.rotation);
+    msg.transforms.push_back(std::move(t));
+  }
+  return msg;
+}
+
 OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in) {
   OdomMessage msg;
   msg.stamp = from_ros_time(in.header.stamp);

@@ -23,9 +23,15 @@ void fill_pose(const PoseMessage& msg, geometry_msgs_msg_dds__PoseStamped_& out)
 void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
                  std::vector<posed_msgs_msg_dds__StreamStatus_>& streams);
 
+/// Points out's transforms at `transforms` (grown as needed) and their strings into `msg`
+/// (valid while msg lives, unchanged).
+void fill_tf(const TfMessage& msg, tf2_msgs_msg_dds__TFMessage_& out,
+             std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms);
+
 OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in);
 PoseMessage to_plain(const geometry_msgs_msg_dds__PoseStamped_& in);
 StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in);
+TfMessage to_plain(const tf2_msgs_msg_dds__TFMessage_& in);
 
 /// A C string field as std::string (Cyclone leaves unset strings null).
 std::string to_string(const char* text);

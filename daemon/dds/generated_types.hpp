@@ -7,3 +7,4 @@
 #include "nav_msgs.h"
 #include "posed_msgs.h"
 #include "std_msgs.h"
+#include "tf2_msgs.h"

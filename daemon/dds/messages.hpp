@@ -16,12 +16,16 @@
 namespace posed::dds {
 
 /// The topics posed publishes.
-enum class Topic { kOdom, kPose, kStatus };
+enum class Topic { kOdom, kPose, kStatus, kTf, kTfStatic };
+inline constexpr std::array kAllTopics = {Topic::kOdom, Topic::kPose, Topic::kStatus, Topic::kTf,
+                                          Topic::kTfStatic};
 
-/// DDS topic names: ROS 2 prefixes topics with "rt/", so ROS sees /posed/odom etc.
+/// DDS topic names: ROS 2 prefixes topics with "rt/", so ROS sees /posed/odom, /tf etc.
 inline constexpr std::string_view kOdomTopic = "rt/posed/odom";
 inline constexpr std::string_view kPoseTopic = "rt/posed/pose";
 inline constexpr std::string_view kStatusTopic = "rt/posed/status";
+inline constexpr std::string_view kTfTopic = "rt/tf";
+inline constexpr std::string_view kTfStaticTopic = "rt/tf_static";
 
 /// The DDS topic name of `topic`, e.g. "rt/posed/odom".
 constexpr std::string_view topic_name(Topic topic) {
@@ -32,16 +36,21 @@ constexpr std::string_view topic_name(Topic topic) {
       return kPoseTopic;
     case Topic::kStatus:
       return kStatusTopic;
+    case Topic::kTf:
+      return kTfTopic;
+    case Topic::kTfStatic:
+      return kTfStaticTopic;
   }
   return {};
 }
 
-/// Accepts "odom", "/posed/odom" or "rt/posed/odom" (and likewise pose, status).
+/// Accepts the DDS name ("rt/posed/odom", "rt/tf"), the ROS name ("/posed/odom", "/tf") or the
+/// last part ("odom", "tf_static").
 constexpr bool parse_topic(std::string_view text, Topic& topic) {
-  for (Topic t : {Topic::kOdom, Topic::kPose, Topic::kStatus}) {
-    const std::string_view full = topic_name(t);  // "rt/posed/<short>"
-    const std::string_view ros = full.substr(2);  // "/posed/<short>"
-    const std::string_view short_name = full.substr(9);
+  for (Topic t : kAllTopics) {
+    const std::string_view full = topic_name(t);
+    const std::string_view ros = full.substr(2);
+    const std::string_view short_name = full.substr(full.rfind('/') + 1);
     if (text == full || text == ros || text == short_name) {
       topic = t;
       return true;
@@ -76,6 +85,24 @@ struct PoseMessage {
   Eigen::Vector3d p_map_base_m = Eigen::Vector3d::Zero();
   /// orientation of the base frame in the map frame [-]
   Eigen::Quaterniond q_map_base = Eigen::Quaterniond::Identity();
+};
+
+/// geometry_msgs/TransformStamped: the pose of `child_frame` in `parent_frame` (tf2's sense: it
+/// maps points from the child frame into the parent frame).
+struct TransformMessage {
+  /// time the transform refers to (wall clock, UNIX epoch) [ns]; any time for a static one
+  WallTime stamp;
+  std::string parent_frame;
+  std::string child_frame;
+  /// position of the child frame's origin in the parent frame [m]
+  Eigen::Vector3d p_parent_child_m = Eigen::Vector3d::Zero();
+  /// orientation of the child frame in the parent frame [-]
+  Eigen::Quaterniond q_parent_child = Eigen::Quaterniond::Identity();
+};
+
+/// tf2_msgs/TFMessage: what rt/tf and rt/tf_static carry.
+struct TfMessage {
+  std::vector<TransformMessage> transforms;
 };
 
 /// posed_msgs/StreamStatus: health of one input stream.
@@ -218,6 +245,8 @@ struct DdsConfig {
   std::string base_frame = "base_link";
   /// Cyclone XML file used to create the domain; empty: CYCLONEDDS_URI or Cyclone's default.
   std::string cyclonedds_xml_path;
+  /// create writers for rt/tf and rt/tf_static (publish.tf)
+  bool tf = true;
   /// DDS Security; empty files: none
   DdsSecurityFiles security;
 };

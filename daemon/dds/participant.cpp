@@ -93,6 +93,9 @@ const dds_topic_descriptor_t& descriptor(Topic topic) {
       return geometry_msgs_msg_dds__PoseStamped__desc;
     case Topic::kStatus:
       return posed_msgs_msg_dds__Status__desc;
+    case Topic::kTf:
+    case Topic::kTfStatic:
+      return tf2_msgs_msg_dds__TFMessage__desc;
   }
   return nav_msgs_msg_dds__Odometry__desc;
 }
@@ -174,13 +177,20 @@ Participant::~Participant() {
   if (holds_domain_ref_) release_domain(domain_id_);
 }
 
-dds_qos_t* make_topic_qos() {
+dds_qos_t* make_topic_qos(Topic topic) {
   dds_qos_t* qos = dds_create_qos();
   // A reliable writer whose readers' buffers are full waits at most this long in dds_write,
   // so a stalled subscriber costs the publishing thread a bounded time, never a hang.
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(10));
-  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+  if (topic == Topic::kTfStatic) {
+    // tf2_ros::StaticBroadcasterQoS: transient-local, and the one latest message holds every
+    // static transform (a static broadcaster resends them all when one changes).
+    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  } else {
+    dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+  }
   const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
   dds_qset_data_representation(qos, 1, &xcdr1);
   return qos;
@@ -188,7 +198,7 @@ dds_qos_t* make_topic_qos() {
 
 dds_entity_t create_topic(dds_entity_t participant, Topic topic, std::string& error) {
   const std::string name(topic_name(topic));
-  dds_qos_t* qos = make_topic_qos();
+  dds_qos_t* qos = make_topic_qos(topic);
   const dds_entity_t handle =
       dds_create_topic(participant, &descriptor(topic), name.c_str(), qos, nullptr);
   dds_delete_qos(qos);

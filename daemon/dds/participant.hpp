@@ -32,9 +32,10 @@ class Participant {
   bool holds_domain_ref_;
 };
 
-/// QoS of every posed topic (DESIGN.md, DDS interface): reliable, volatile, keep-last 10, XCDR1
-/// (the plain CDR ROS 2 uses). Caller deletes with dds_delete_qos.
-dds_qos_t* make_topic_qos();
+/// QoS of a posed topic (DESIGN.md, DDS interface): reliable, volatile, keep-last 10, XCDR1
+/// (the plain CDR ROS 2 uses); rt/tf_static transient-local, as ROS 2's static broadcaster, so a
+/// late joiner gets the transforms. Caller deletes with dds_delete_qos.
+dds_qos_t* make_topic_qos(Topic topic);
 
 /// Creates the topic `topic` of the type its descriptor names; error names the topic.
 dds_entity_t create_topic(dds_entity_t participant, Topic topic, std::string& error);

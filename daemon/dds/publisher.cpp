@@ -13,6 +13,8 @@ struct Publisher::Impl {
   dds_entity_t odom_writer = 0;
   dds_entity_t pose_writer = 0;
   dds_entity_t status_writer = 0;
+  dds_entity_t tf_writer = 0;         ///< 0 unless DdsConfig::tf
+  dds_entity_t tf_static_writer = 0;  ///< 0 unless DdsConfig::tf
   // Frame ids live here for the publisher's lifetime; the samples point into them.
   std::string map_frame;
   std::string base_frame;
@@ -20,6 +22,10 @@ struct Publisher::Impl {
   geometry_msgs_msg_dds__PoseStamped_ pose_sample{};
   posed_msgs_msg_dds__Status_ status_sample{};
   std::vector<posed_msgs_msg_dds__StreamStatus_> status_streams;
+  tf2_msgs_msg_dds__TFMessage_ tf_sample{};
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> tf_transforms;
+  tf2_msgs_msg_dds__TFMessage_ tf_static_sample{};
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> tf_static_transforms;
   std::atomic<std::uint64_t> write_failures{0};
 
   bool write(dds_entity_t writer, const void* sample) {
@@ -35,11 +41,12 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
   if (!impl->participant) return nullptr;
   const dds_entity_t participant = impl->participant->handle();
 
-  dds_qos_t* qos = detail::make_topic_qos();
   const auto make_writer = [&](Topic topic, dds_entity_t& writer) {
     const dds_entity_t t = detail::create_topic(participant, topic, error);
     if (t < 0) return false;
+    dds_qos_t* qos = detail::make_topic_qos(topic);
     writer = dds_create_writer(participant, t, qos, nullptr);
+    dds_delete_qos(qos);
     if (writer < 0) {
       error = detail::describe_error(std::string(topic_name(topic)) + ": create writer", writer);
       return false;
@@ -48,8 +55,9 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
   };
   const bool ok = make_writer(Topic::kOdom, impl->odom_writer) &&
                   make_writer(Topic::kPose, impl->pose_writer) &&
-                  make_writer(Topic::kStatus, impl->status_writer);
-  dds_delete_qos(qos);
+                  make_writer(Topic::kStatus, impl->status_writer) &&
+                  (!config.tf || (make_writer(Topic::kTf, impl->tf_writer) &&
+                                  make_writer(Topic::kTfStatic, impl->tf_static_writer)));
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
 
   impl->map_frame = config.map_frame;
@@ -81,10 +89,38 @@ bool Publisher::publish_status(const StatusMessage& msg) {
   return impl_->write(impl_->status_writer, &impl_->status_sample);
 }
 
+bool Publisher::publish_tf(const TfMessage& msg) {
+  if (impl_->tf_writer == 0) return false;
+  detail::fill_tf(msg, impl_->tf_sample, impl_->tf_transforms);
+  return impl_->write(impl_->tf_writer, &impl_->tf_sample);
+}
+
+bool Publisher::publish_tf_static(const TfMessage& msg) {
+  if (impl_->tf_static_writer == 0) return false;
+  detail::fill_tf(msg, impl_->tf_static_sample, impl_->tf_static_transforms);
+  return impl_->write(impl_->tf_static_writer, &impl_->tf_static_sample);
+}
+
 std::uint32_t Publisher::matched_subscribers(Topic topic) const {
-  const dds_entity_t writer = topic == Topic::kOdom   ? impl_->odom_writer
-                              : topic == Topic::kPose ? impl_->pose_writer
-                                                      : impl_->status_writer;
+  dds_entity_t writer = 0;
+  switch (topic) {
+    case Topic::kOdom:
+      writer = impl_->odom_writer;
+      break;
+    case Topic::kPose:
+      writer = impl_->pose_writer;
+      break;
+    case Topic::kStatus:
+      writer = impl_->status_writer;
+      break;
+    case Topic::kTf:
+      writer = impl_->tf_writer;
+      break;
+    case Topic::kTfStatic:
+      writer = impl_->tf_static_writer;
+      break;
+  }
+  if (writer == 0) return 0;
   dds_publication_matched_status_t status{};
   if (dds_get_publication_matched_status(writer, &status) != DDS_RETCODE_OK) return 0;
   return status.current_count;

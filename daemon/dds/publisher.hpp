@@ -1,6 +1,7 @@
 #pragma once
 // posed's DDS output (DESIGN.md, DDS interface): nav_msgs/Odometry on rt/posed/odom,
-// geometry_msgs/PoseStamped on rt/posed/pose and posed_msgs/Status on rt/posed/status, with
+// geometry_msgs/PoseStamped on rt/posed/pose, posed_msgs/Status on rt/posed/status and
+// tf2_msgs/TFMessage on rt/tf and rt/tf_static, with
 // ROS 2's DDS type names, so `ros2 topic echo /posed/odom` or any plain DDS reader receives them.
 
 #include <cstdint>
@@ -27,6 +28,11 @@ class Publisher {
   bool publish_odom(const OdomMessage& msg);
   bool publish_pose(const PoseMessage& msg);
   bool publish_status(const StatusMessage& msg);
+  /// rt/tf (false, and nothing sent, when created without DdsConfig::tf).
+  bool publish_tf(const TfMessage& msg);
+  /// rt/tf_static, transient-local: the last message (all static transforms) reaches readers
+  /// that join later.
+  bool publish_tf_static(const TfMessage& msg);
 
   /// Readers currently matched on `topic` [count]; samples before a match are not delivered
   /// (volatile durability), so tests and benchmarks wait for this first.

@@ -11,7 +11,7 @@ namespace posed::dds {
 struct Subscriber::Impl {
   std::unique_ptr<detail::Participant> participant;
   /// reader per Topic (index = enum value); 0 when not subscribed
-  std::array<dds_entity_t, 3> readers{};
+  std::array<dds_entity_t, kAllTopics.size()> readers{};
   dds_entity_t waitset = 0;
 
   dds_entity_t reader(Topic topic) const { return readers[static_cast<std::size_t>(topic)]; }
@@ -47,8 +47,8 @@ struct Subscriber::Impl {
 
 std::unique_ptr<Subscriber> Subscriber::create(const DdsConfig& config,
                                                std::span<const Topic> topics, std::string& error) {
-  static constexpr std::array kAll = {Topic::kOdom, Topic::kPose, Topic::kStatus};
-  if (topics.empty()) topics = kAll;
+  static constexpr std::array kPosed = {Topic::kOdom, Topic::kPose, Topic::kStatus};
+  if (topics.empty()) topics = kPosed;
   auto impl = std::make_unique<Impl>();
   impl->participant = detail::Participant::open(config, error);
   if (!impl->participant) return nullptr;
@@ -58,7 +58,6 @@ std::unique_ptr<Subscriber> Subscriber::create(const DdsConfig& config,
     error = detail::describe_error("DDS waitset", impl->waitset);
     return nullptr;
   }
-  dds_qos_t* qos = detail::make_topic_qos();
   bool ok = true;
   for (Topic topic : topics) {
     dds_entity_t& reader = impl->readers[static_cast<std::size_t>(topic)];
@@ -69,7 +68,9 @@ std::unique_ptr<Subscriber> Subscriber::create(const DdsConfig& config,
       ok = false;
       break;
     }
+    dds_qos_t* qos = detail::make_topic_qos(topic);
     reader = dds_create_reader(participant, t, qos, nullptr);
+    dds_delete_qos(qos);
     if (reader < 0) {
       error = detail::describe_error(name + ": create reader", reader);
       ok = false;
@@ -84,7 +85,6 @@ std::unique_ptr<Subscriber> Subscriber::create(const DdsConfig& config,
       break;
     }
   }
-  dds_delete_qos(qos);
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
   return std::unique_ptr<Subscriber>(new Subscriber(std::move(impl)));
 }
@@ -118,6 +118,12 @@ std::size_t Subscriber::take_status(std::vector<Received<StatusMessage>>& out) {
       Topic::kStatus, out, [](const posed_msgs_msg_dds__Status_& s, Received<StatusMessage>& r) {
         r.frame_id = detail::to_string(s.header.frame_id);
       });
+}
+
+std::size_t Subscriber::take_tf(Topic topic, std::vector<Received<TfMessage>>& out) {
+  if (topic != Topic::kTf && topic != Topic::kTfStatic) return 0;
+  return impl_->take<tf2_msgs_msg_dds__TFMessage_>(
+      topic, out, [](const tf2_msgs_msg_dds__TFMessage_&, Received<TfMessage>&) {});
 }
 
 std::uint32_t Subscriber::matched_publishers(Topic topic) const {

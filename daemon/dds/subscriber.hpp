@@ -31,7 +31,8 @@ struct Received {
 /// Not thread-safe: one thread waits and takes.
 class Subscriber {
  public:
-  /// nullptr with `error` set on failure. `topics` empty means all three.
+  /// nullptr with `error` set on failure. `topics` empty means posed's three (odom, pose,
+  /// status).
   static std::unique_ptr<Subscriber> create(const DdsConfig& config, std::span<const Topic> topics,
                                             std::string& error);
   ~Subscriber();
@@ -46,6 +47,8 @@ class Subscriber {
   std::size_t take_odom(std::vector<Received<OdomMessage>>& out);
   std::size_t take_pose(std::vector<Received<PoseMessage>>& out);
   std::size_t take_status(std::vector<Received<StatusMessage>>& out);
+  /// rt/tf or rt/tf_static (`topic`); the frames are in each transform.
+  std::size_t take_tf(Topic topic, std::vector<Received<TfMessage>>& out);
 
   /// Writers currently matched on `topic` [count].
   std::uint32_t matched_publishers(Topic topic) const;

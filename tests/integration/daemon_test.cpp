@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <map>
 
+#include "daemon/config/config_loader.hpp"
 #include "daemon/dds/subscriber.hpp"
 #include "tests/integration/notify_listener.hpp"
 #include "tests/integration/posed_process.hpp"
@@ -100,6 +103,91 @@ TEST(Daemon, PublishesOdomThatFollowsTheKnownMotionAndStopsOnSigterm) {
   EXPECT_EQ(*code, 0) << posed.err();
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
   EXPECT_NE(posed.out().find("posed summary"), std::string::npos) << posed.out();
+}
+
+// rt/tf carries map -> odom -> base_link with every pose, so the two transforms chain to the
+// pose posed publishes; rt/tf_static carries base_link -> lidar, camera and thermal from the
+// configured extrinsics, and a reader that joins later still gets it (transient-local).
+TEST(Daemon, PublishesTheTfTreeAndStaticTransformsToLateJoiners) {
+  TempDir dir;
+  const std::string config = dir.write("posed.yaml", demo_like_config());
+  std::string error;
+  const std::array topics = {dds::Topic::kPose, dds::Topic::kTf};
+  auto reader = dds::Subscriber::create(reader_config(), topics, error);
+  ASSERT_TRUE(reader) << error;
+
+  PosedProcess posed(posed_argv(config), {}, dir);
+  std::vector<dds::Received<dds::PoseMessage>> poses;
+  std::vector<dds::Received<dds::TfMessage>> tf;
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (tf.size() < 30 && std::chrono::steady_clock::now() < deadline) {
+    reader->wait(Duration::from_ms(100));
+    reader->take_pose(poses);
+    reader->take_tf(dds::Topic::kTf, tf);
+  }
+  reader->take_pose(poses);
+  ASSERT_GE(tf.size(), 30u) << "stderr:\n" << posed.err();
+
+  std::map<std::int64_t, const dds::PoseMessage*> pose_at;
+  for (const auto& p : poses) pose_at[p.msg.stamp.ns] = &p.msg;
+  std::size_t matched = 0;
+  for (const auto& r : tf) {
+    ASSERT_EQ(r.msg.transforms.size(), 2u);
+    const dds::TransformMessage& map_odom = r.msg.transforms[0];
+    const dds::TransformMessage& odom_base = r.msg.transforms[1];
+    EXPECT_EQ(map_odom.parent_frame, "map");
+    EXPECT_EQ(map_odom.child_frame, "odom");
+    EXPECT_EQ(odom_base.parent_frame, "odom");
+    EXPECT_EQ(odom_base.child_frame, "base_link");
+    // map -> odom -> base_link resolves to the pose of base_link in map.
+    const Eigen::Isometry3d T_map_base =
+        (Eigen::Translation3d(map_odom.p_parent_child_m) * map_odom.q_parent_child) *
+        (Eigen::Translation3d(odom_base.p_parent_child_m) * odom_base.q_parent_child);
+    const auto pose = pose_at.find(odom_base.stamp.ns);
+    if (pose == pose_at.end()) continue;  // its pose sample not taken yet
+    ++matched;
+    EXPECT_LT((T_map_base.translation() - pose->second->p_map_base_m).norm(), 1e-9);
+    EXPECT_LT(Eigen::Quaterniond(T_map_base.rotation()).angularDistance(pose->second->q_map_base),
+              1e-9);
+  }
+  EXPECT_GT(matched, tf.size() / 2) << "tf stamps are not the poses' stamps";
+
+  // A reader that joins now, long after posed sent its static transforms, still gets them.
+  const std::array static_topic = {dds::Topic::kTfStatic};
+  auto late = dds::Subscriber::create(reader_config(), static_topic, error);
+  ASSERT_TRUE(late) << error;
+  std::vector<dds::Received<dds::TfMessage>> statics;
+  const auto static_deadline = std::chrono::steady_clock::now() + 10s;
+  while (statics.empty() && std::chrono::steady_clock::now() < static_deadline) {
+    late->wait(Duration::from_ms(100));
+    late->take_tf(dds::Topic::kTfStatic, statics);
+  }
+  ASSERT_EQ(statics.size(), 1u);
+  const auto& transforms = statics.front().msg.transforms;
+  ASSERT_EQ(transforms.size(), 3u);
+  const config::LoadResult loaded = config::load_config_file(config);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_text();
+  const auto matrix = [](const config::Transform4& T) {
+    Eigen::Matrix4d m;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) m(r, c) = T[static_cast<std::size_t>(r * 4 + c)];
+    return m;
+  };
+  const auto& e = loaded.config.extrinsics;
+  const Eigen::Matrix4d expected[] = {matrix(e.T_imu_lidar), matrix(e.T_imu_cam),
+                                      matrix(e.T_imu_cam) * matrix(e.T_cam_thermal)};
+  const char* children[] = {"velodyne", "camera_color_optical_frame", "thermal_optical_frame"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(transforms[i].parent_frame, "base_link");
+    EXPECT_EQ(transforms[i].child_frame, children[i]);
+    EXPECT_LT((transforms[i].p_parent_child_m - expected[i].block<3, 1>(0, 3)).norm(), 1e-9);
+    const Eigen::Quaterniond q_expected(Eigen::Matrix3d(expected[i].block<3, 3>(0, 0)));
+    EXPECT_LT(transforms[i].q_parent_child.angularDistance(q_expected), 1e-6) << children[i];
+  }
+  // Not the identity: the rig's extrinsics really went out.
+  EXPECT_GT(transforms[0].p_parent_child_m.norm() + transforms[1].p_parent_child_m.norm(), 0.01);
+  posed.signal(SIGTERM);
+  EXPECT_EQ(posed.wait_for_exit(10s), 0) << posed.err();
 }
 
 TEST(Daemon, TellsSystemdReadyThenFeedsTheWatchdogThenStopping) {

@@ -223,7 +223,7 @@ int bench_dds() {
   KeystoreSpec spec;
   spec.dir = keystore;
   spec.domain_id = static_cast<int>(secure.domain_id);
-  spec.enclaves = {{"posed", {"rt/posed/*"}, {}}, {"posectl", {}, {"rt/posed/*"}}};
+  spec.enclaves = {{"posed", kPosedTopics, {}}, {"posectl", {}, kPosedTopics}};
   std::string error;
   if (!create_keystore(spec, error)) {
     std::fprintf(stderr, "posectl bench dds: keystore: %s\n", error.c_str());

@@ -184,6 +184,30 @@ void print_pose(const dds::Received<dds::PoseMessage>& r, bool as_csv) {
       q.w(), yaw_deg(q), lat);
 }
 
+void print_tf_header_csv() {
+  std::printf("stamp_s,receive_s,latency_ms,parent_frame,child_frame,x_m,y_m,z_m,qx,qy,qz,qw\n");
+}
+
+/// One line per transform: parent -> child, translation [m], rotation, yaw [deg].
+void print_tf(const dds::Received<dds::TfMessage>& r, bool as_csv) {
+  for (const auto& t : r.msg.transforms) {
+    const auto& p = t.p_parent_child_m;
+    const auto& q = t.q_parent_child;
+    const double lat = (r.received_wall - t.stamp).seconds() * 1e3;
+    if (as_csv) {
+      std::printf("%s,%s,%.3f,%s,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f\n",
+                  stamp_text(t.stamp).c_str(), stamp_text(r.received_wall).c_str(), lat,
+                  csv(t.parent_frame).c_str(), csv(t.child_frame).c_str(), p.x(), p.y(), p.z(),
+                  q.x(), q.y(), q.z(), q.w());
+    } else {
+      std::printf(
+          "tf %s s  %s -> %s  p [%.3f %.3f %.3f] m  q(xyzw) [%.4f %.4f %.4f %.4f] yaw %.2f deg\n",
+          stamp_text(t.stamp).c_str(), t.parent_frame.c_str(), t.child_frame.c_str(), p.x(), p.y(),
+          p.z(), q.x(), q.y(), q.z(), q.w(), yaw_deg(q));
+    }
+  }
+}
+
 void print_status_header_csv() {
   std::printf(
       "stamp_s,receive_s,latency_ms,version,estimator_mode,uptime_s,summary,stream,rate_hz,"
@@ -307,6 +331,15 @@ void write_tum(std::FILE* tum, const dds::Received<dds::PoseMessage>& r) {
   write_tum(tum, r.msg.stamp, r.msg.p_map_base_m, r.msg.q_map_base);
 }
 void write_tum(std::FILE*, const dds::Received<dds::StatusMessage>&) {}
+void write_tum(std::FILE*, const dds::Received<dds::TfMessage>&) {}
+
+/// The stamp a message's latency is measured from (a tf message: its first transform's).
+WallTime stamp_of(const dds::OdomMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::PoseMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::StatusMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::TfMessage& m) {
+  return m.transforms.empty() ? WallTime{} : m.transforms.front().stamp;
+}
 
 /// Takes everything waiting on `topic`, prints it, feeds the stats; returns how many.
 template <class Message, class Take, class Print>
@@ -322,7 +355,7 @@ std::size_t drain(Take take, Print print, bool as_csv, std::FILE* tum, EchoStats
     } else {
       print(r, as_csv);
     }
-    stats.add(r.msg.stamp, r.received_wall, r.received_host);
+    stats.add(stamp_of(r.msg), r.received_wall, r.received_host);
     ++printed;
   }
   std::fflush(stdout);
@@ -345,7 +378,8 @@ int run_echo(int argc, char** argv) {
   std::string tum_path;
   std::string enclave;
   app.add_option("topic", topic_arg,
-                 "odom, pose, status, or the full DDS name (rt/posed/odom) or ROS name")
+                 "odom, pose, status, tf, tf_static, or the full DDS name (rt/posed/odom, rt/tf) "
+                 "or ROS name")
       ->capture_default_str();
   app.add_flag("--csv", as_csv,
                "CSV with a header line on stdout; rate/latency reports go to stderr");
@@ -370,14 +404,15 @@ int run_echo(int argc, char** argv) {
   dds::Topic topic = dds::Topic::kOdom;
   if (!dds::parse_topic(topic_arg, topic)) {
     std::fprintf(stderr,
-                 "posectl echo: unknown topic '%s' (expected odom, pose, status or "
-                 "rt/posed/{odom,pose,status})\n",
+                 "posectl echo: unknown topic '%s' (expected odom, pose, status, tf, tf_static "
+                 "or their DDS names rt/posed/{odom,pose,status}, rt/tf, rt/tf_static)\n",
                  topic_arg.c_str());
     return 2;
   }
   const std::string topic_name(dds::topic_name(topic));
-  if (!tum_path.empty() && topic == dds::Topic::kStatus) {
-    std::fprintf(stderr, "posectl echo: --tum needs a pose topic (odom or pose), not status\n");
+  if (!tum_path.empty() && topic != dds::Topic::kOdom && topic != dds::Topic::kPose) {
+    std::fprintf(stderr, "posectl echo: --tum needs a pose topic (odom or pose), not %s\n",
+                 topic_arg.c_str());
     return 2;
   }
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> tum(nullptr, &std::fclose);
@@ -409,6 +444,7 @@ int run_echo(int argc, char** argv) {
     if (topic == dds::Topic::kOdom) print_odom_header_csv();
     if (topic == dds::Topic::kPose) print_pose_header_csv();
     if (topic == dds::Topic::kStatus) print_status_header_csv();
+    if (topic == dds::Topic::kTf || topic == dds::Topic::kTfStatic) print_tf_header_csv();
   }
   std::fprintf(stderr, "posectl echo: listening on %s (domain %u)\n", topic_name.c_str(), domain);
 
@@ -442,6 +478,11 @@ int run_echo(int argc, char** argv) {
       case dds::Topic::kStatus:
         drain<dds::StatusMessage>([&](auto& v) { subscriber->take_status(v); }, print_status,
                                   as_csv, nullptr, stats, count);
+        break;
+      case dds::Topic::kTf:
+      case dds::Topic::kTfStatic:
+        drain<dds::TfMessage>([&](auto& v) { subscriber->take_tf(topic, v); }, print_tf, as_csv,
+                              nullptr, stats, count);
         break;
     }
   }

@@ -1,7 +1,7 @@
 // posectl security init DIR: a DDS Security keystore for posed in SROS2's layout
 // (tools/posectl/keystore.hpp): a CA, the governance document, and the enclaves "posed" (publishes
-// rt/posed/*) and "posectl" (reads rt/posed/*), plus one reader enclave per --reader NAME for the
-// programs that consume posed's poses. Run again with other --reader names to add enclaves signed
+// rt/posed/*, rt/tf and rt/tf_static) and "posectl" (reads them), plus one reader enclave per
+// --reader NAME for the programs that consume posed's poses. Run again with other --reader names to add enclaves signed
 // by the same CA. posed takes an enclave with `dds.security.enclave: DIR/enclaves/posed`, posectl
 // echo with `--enclave DIR/enclaves/posectl` (docs/security.md).
 // Exit codes: 0 written, 1 a file could not be made, 2 bad arguments.
@@ -33,22 +33,23 @@ int run_security(int argc, char** argv) {
   init->add_option("--days", days, "validity of certificates and permissions [days]")
       ->check(CLI::Range(1, 36500));
   init->add_option("--reader", readers,
-                   "another enclave allowed to read rt/posed/* (repeatable), e.g. a controller");
+                   "another enclave allowed to read rt/posed/*, rt/tf and rt/tf_static "
+                   "(repeatable), e.g. a controller");
   CLI11_PARSE(app, argc, argv);
 
   KeystoreSpec spec;
   spec.dir = dir;
   spec.domain_id = domain_id;
   spec.valid_days = days;
-  spec.enclaves.push_back({"posed", {"rt/posed/*"}, {}});
-  spec.enclaves.push_back({"posectl", {}, {"rt/posed/*"}});
+  spec.enclaves.push_back({"posed", kPosedTopics, {}});
+  spec.enclaves.push_back({"posectl", {}, kPosedTopics});
   for (const std::string& name : readers) {
     if (name.empty() || name.find_first_of("/. ") != std::string::npos) {
       std::fprintf(stderr, "posectl security init: --reader '%s': a plain name, no '/', '.', ' '\n",
                    name.c_str());
       return 2;
     }
-    spec.enclaves.push_back({name, {}, {"rt/posed/*"}});
+    spec.enclaves.push_back({name, {}, kPosedTopics});
   }
   std::string error;
   if (!create_keystore(spec, error)) {
@@ -60,7 +61,7 @@ int run_security(int argc, char** argv) {
               domain_id < 0 ? "every domain" : ("domain " + std::to_string(domain_id)).c_str());
   for (const EnclaveSpec& e : spec.enclaves) {
     std::printf("  enclaves/%-10s %s %s\n", e.name.c_str(),
-                e.publish.empty() ? "reads" : "publishes", "rt/posed/*");
+                e.publish.empty() ? "reads" : "publishes", "rt/posed/*, rt/tf, rt/tf_static");
   }
   return 0;
 }

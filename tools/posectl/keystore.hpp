@@ -14,6 +14,9 @@
 
 namespace posed::posectl {
 
+/// What posed writes and its readers read: its own topics and the tf tree.
+inline const std::vector<std::string> kPosedTopics = {"rt/posed/*", "rt/tf", "rt/tf_static"};
+
 struct EnclaveSpec {
   std::string name;                  ///< "posed" -> enclaves/posed, subject CN=/posed
   std::vector<std::string> publish;  ///< DDS topic names or fnmatch patterns ("rt/posed/*")

@@ -35,7 +35,7 @@ class CdrLoop : public ::testing::Test {
     const dds_entity_t pp = participant_->handle();
     std::string name = std::string("posed_test/") + desc.m_typename;
     std::replace(name.begin(), name.end(), ':', '_');  // ':' is not allowed in topic names
-    dds_qos_t* qos = detail::make_topic_qos();
+    dds_qos_t* qos = detail::make_topic_qos(Topic::kOdom);
     const dds_entity_t topic = dds_create_topic(pp, &desc, name.c_str(), qos, nullptr);
     EXPECT_GT(topic, 0) << name << ": " << dds_strretcode(topic);
     if (topic <= 0) return {};
