@@ -18,70 +18,34 @@ std::array<double, 36> to_row_major(const Eigen::Matrix<double, 6, 6>& m) {
   return out;
 }
 
-/// A row-major 4x4 T_parent_child as a tf transform.
-dds::TransformMessage transform(const config::Transform4& T, WallTime stamp,
-                                const std::string& parent, const std::string& child) {
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) m(r, c) = T[static_cast<std::size_t>(r * 4 + c)];
-  }
-  dds::TransformMessage t;
-  t.stamp = stamp;
-  t.parent_frame = parent;
-  t.child_frame = child;
-  t.p_parent_child_m = m.block<3, 1>(0, 3);
-  t.q_parent_child = Eigen::Quaterniond(m.block<3, 3>(0, 0)).normalized();
-  return t;
-}
-
-config::Transform4 compose(const config::Transform4& a, const config::Transform4& b) {
-  config::Transform4 out{};
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) {
-      double sum = 0;
-      for (int k = 0; k < 4; ++k) {
-        sum += a[static_cast<std::size_t>(r * 4 + k)] * b[static_cast<std::size_t>(k * 4 + c)];
-      }
-      out[static_cast<std::size_t>(r * 4 + c)] = sum;
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 void PoseSinks::static_transforms() {
   if (!publisher_ || !config_.publish.tf) return;
-  const auto& e = config_.extrinsics;
-  const auto& d = config_.dds;
-  const WallTime now = drivers::wall_now();
-  dds::TfMessage msg;
-  msg.transforms = {
-      transform(e.T_imu_lidar, now, d.base_frame, d.lidar_frame),
-      transform(e.T_imu_cam, now, d.base_frame, d.camera_frame),
-      transform(compose(e.T_imu_cam, e.T_cam_thermal), now, d.base_frame, d.thermal_frame)};
-  if (!publisher_->publish_tf_static(msg)) tally_.failed.fetch_add(1, std::memory_order_relaxed);
+  if (!publisher_->publish_tf_static(posed::static_transforms(config_, drivers::wall_now()))) {
+    tally_.failed.fetch_add(1, std::memory_order_relaxed);
+  }
 }
 
-void PoseSinks::tf(const NavState& s, WallTime stamp) {
-  if (!publisher_ || !config_.publish.tf) return;
-  if (config_.publish.tf_max_rate_hz > 0) {
-    if (s.stamp < next_tf_stamp_) return;
-    next_tf_stamp_ = s.stamp + Duration::from_seconds(1.0 / config_.publish.tf_max_rate_hz);
+void PoseSinks::ros_outputs(const NavState& s, const dds::PoseMessage& pose) {
+  if (!publisher_) return;
+  if (config_.publish.tf && (config_.publish.tf_max_rate_hz <= 0 || s.stamp >= next_tf_stamp_)) {
+    if (config_.publish.tf_max_rate_hz > 0) {
+      next_tf_stamp_ = s.stamp + Duration::from_seconds(1.0 / config_.publish.tf_max_rate_hz);
+    }
+    if (!publisher_->publish_tf(tf_tree(config_.dds, s, pose.stamp))) {
+      tally_.failed.fetch_add(1, std::memory_order_relaxed);
+    }
   }
-  const auto& d = config_.dds;
-  dds::TfMessage msg;
-  msg.transforms.resize(2);
-  // No map correction exists yet (no loop closure or prior map): map and odom coincide.
-  msg.transforms[0].stamp = stamp;
-  msg.transforms[0].parent_frame = d.map_frame;
-  msg.transforms[0].child_frame = d.odom_frame;
-  msg.transforms[1].stamp = stamp;
-  msg.transforms[1].parent_frame = d.odom_frame;
-  msg.transforms[1].child_frame = d.base_frame;
-  msg.transforms[1].p_parent_child_m = s.p_map_base_m;
-  msg.transforms[1].q_parent_child = s.q_map_base;
-  if (!publisher_->publish_tf(msg)) tally_.failed.fetch_add(1, std::memory_order_relaxed);
+  if (config_.publish.path) {
+    path_.add(pose);
+    if (s.stamp >= next_path_stamp_) {
+      next_path_stamp_ = s.stamp + Duration::from_seconds(1.0 / config_.publish.path_rate_hz);
+      if (!publisher_->publish_path(path_.path())) {
+        tally_.failed.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+  }
 }
 
 PoseSinks::PoseSinks(const config::PosedConfig& config, dds::Publisher* publisher,
@@ -93,7 +57,9 @@ PoseSinks::PoseSinks(const config::PosedConfig& config, dds::Publisher* publishe
       to_wall_(to_wall),
       started_(started),
       live_clock_(live_clock),
-      pose_period_(Duration::from_seconds(1.0 / config.publish.pose_rate_hz)) {}
+      pose_period_(Duration::from_seconds(1.0 / config.publish.pose_rate_hz)),
+      path_(config.publish.path_min_step_m,
+            static_cast<std::size_t>(config.publish.path_max_poses)) {}
 
 void PoseSinks::odom(const NavState& s) {
   if (tally_.last) tally_.distance_m += (s.p_map_base_m - tally_.last->p_map_base_m).norm();
@@ -151,7 +117,7 @@ void PoseSinks::state(const NavState& s) {
     } else {
       tally_.failed.fetch_add(1, std::memory_order_relaxed);
     }
-    tf(s, stamp);
+    ros_outputs(s, pose);
     if (recorder_) {
       const Eigen::Quaterniond& q = s.q_map_base;
       recorder_->write_pose("/posed/pose", stamp, config_.dds.map_frame,
@@ -239,6 +205,10 @@ void PoseSinks::status(const pipeline::PipelineStatus& st) {
   } else if (publisher_->publish_status(msg)) {
     ++tally_.status;
   } else {
+    tally_.failed.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (publisher_ && config_.publish.diagnostics &&
+      !publisher_->publish_diagnostics(diagnostics(st, msg.stamp))) {
     tally_.failed.fetch_add(1, std::memory_order_relaxed);
   }
   std::lock_guard lock(status_line_mutex_);

@@ -16,6 +16,7 @@
 #include "daemon/dds/messages.hpp"
 #include "daemon/pipeline/latency_histogram.hpp"
 #include "daemon/pipeline/pipeline_status.hpp"
+#include "daemon/ros_outputs.hpp"
 
 namespace posed {
 
@@ -104,7 +105,7 @@ class PoseSinks {
   /// back end's propagation (when odometry is not decoupled) to odom(), and decimated onto pose
   /// for an estimator without optimised states.
   void state(const NavState& s);
-  /// rt/posed/status, and the line for systemd's STATUS=.
+  /// rt/posed/status and rt/diagnostics, and the line for systemd's STATUS=.
   void status(const pipeline::PipelineStatus& st);
   /// rt/tf_static: base_link -> lidar, camera and thermal frames from the configured
   /// extrinsics. Once at start (transient-local: later readers get it too).
@@ -127,8 +128,10 @@ class PoseSinks {
   Duration pose_period_;
   std::uint64_t odom_index_ = 0;
   HostTime next_tf_stamp_;
-  /// rt/tf with `s` as odom -> base_link (and map -> odom identity), rate-limited.
-  void tf(const NavState& s, WallTime stamp);
+  HostTime next_path_stamp_;
+  PathBuilder path_;
+  /// With each pose: rt/tf (rate-limited) and the path (published at publish.path_rate_hz).
+  void ros_outputs(const NavState& s, const dds::PoseMessage& pose);
   PublishTally tally_;
   TopicLatency odom_latency_{"rt/posed/odom", {}, {}};
   TopicLatency pose_latency_{"rt/posed/pose", {}, {}};

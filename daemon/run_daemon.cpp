@@ -104,6 +104,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds_config.cyclonedds_xml_path = config.dds.cyclonedds_config;
   dds_config.security = dds_security_files(config.dds.security);
   dds_config.tf = config.publish.tf;
+  dds_config.path = config.publish.path;
+  dds_config.diagnostics = config.publish.diagnostics;
   std::string error;
   std::unique_ptr<dds::Publisher> publisher;
   if (options.publish_dds) publisher = dds::Publisher::create(dds_config, error);

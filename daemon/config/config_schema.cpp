@@ -67,6 +67,16 @@ const Field kSchema[] = {
       "rt/tf_static (base_link -> lidar, camera, thermal from the extrinsics)"),
     F("publish.tf_max_rate_hz", publish.tf_max_rate_hz, "0", "Hz", 0, 1000, "",
       "at most this many rt/tf messages per second; 0: one with every rt/posed/pose"),
+    F("publish.path", publish.path, "true", "", 0, 0, "", "rt/posed/path (nav_msgs/Path)"),
+    F("publish.path_rate_hz", publish.path_rate_hz, "1", "Hz", 0.1, 100, "",
+      "rt/posed/path messages per second"),
+    F("publish.path_min_step_m", publish.path_min_step_m, "0.1", "m", 0, 100, "",
+      "a pose joins the path once the base moved this far from the last one kept"),
+    F("publish.path_max_poses", publish.path_max_poses, "10000", "", 10, 1000000, "",
+      "past this many poses every other old one is dropped (the whole run stays, coarser)"),
+    F("publish.diagnostics", publish.diagnostics, "true", "", 0, 0, "",
+      "rt/diagnostics (diagnostic_msgs/DiagnosticArray) with each status: one per stream and "
+      "one for the estimator"),
 
     F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial|can",
       "where IMU samples come from: the synthetic circle, the A9 over serial, or an IMU on a "

@@ -53,6 +53,11 @@ struct PublishSection {
   /// rt/tf (map -> odom -> base_link, with each pose) and rt/tf_static (base_link -> sensors)
   bool tf = true;
   double tf_max_rate_hz = 0;  ///< at most this many rt/tf messages per second; 0: every pose [Hz]
+  bool path = true;           ///< rt/posed/path
+  double path_rate_hz = 1.0;  ///< rt/posed/path messages per second [Hz]
+  double path_min_step_m = 0.1;  ///< a pose joins the path after the base moved this far [m]
+  int path_max_poses = 10000;    ///< past this, every other old pose is dropped [count]
+  bool diagnostics = true;       ///< rt/diagnostics, with each status
 };
 
 struct ImuSection {

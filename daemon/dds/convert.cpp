@@ -163,6 +163,79 @@ void fill_tf(const TfMessage& msg, tf2_msgs_msg_dds__TFMessage_& out,
   out.transforms._release = false;  // the buffer belongs to the caller, not to Cyclone
 }
 
+void fill_path(const PathMessage& msg, char* frame_id, nav_msgs_msg_dds__Path_& out,
+               std::vector<geometry_msgs_msg_dds__PoseStamped_>& poses) {
+  if (poses.size() < msg.poses.size()) poses.resize(msg.poses.size());
+  for (std::size_t i = 0; i < msg.poses.size(); ++i) {
+    fill_pose(msg.poses[i], poses[i]);
+    poses[i].header.frame_id = frame_id;
+  }
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.header.frame_id = frame_id;
+  out.poses._buffer = poses.data();
+  out.poses._length = static_cast<std::uint32_t>(msg.poses.size());
+  out.poses._maximum = static_cast<std::uint32_t>(poses.size());
+  out.poses._release = false;  // the buffer belongs to the caller, not to Cyclone
+}
+
+void fill_diagnostics(const DiagnosticsMessage& msg, diagnostic_msgs_msg_dds__DiagnosticArray_& out,
+                      std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_>& statuses,
+                      std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>>& values) {
+  if (statuses.size() < msg.status.size()) statuses.resize(msg.status.size());
+  if (values.size() < msg.status.size()) values.resize(msg.status.size());
+  for (std::size_t i = 0; i < msg.status.size(); ++i) {
+    const DiagnosticStatusMessage& m = msg.status[i];
+    diagnostic_msgs_msg_dds__DiagnosticStatus_& d = statuses[i];
+    d.level = m.level;
+    d.name = c_str(m.name);
+    d.message = c_str(m.message);
+    d.hardware_id = c_str(m.hardware_id);
+    std::vector<diagnostic_msgs_msg_dds__KeyValue_>& kv = values[i];
+    if (kv.size() < m.values.size()) kv.resize(m.values.size());
+    for (std::size_t k = 0; k < m.values.size(); ++k) {
+      kv[k].key = c_str(m.values[k].first);
+      kv[k].value = c_str(m.values[k].second);
+    }
+    d.values._buffer = kv.data();
+    d.values._length = static_cast<std::uint32_t>(m.values.size());
+    d.values._maximum = static_cast<std::uint32_t>(kv.size());
+    d.values._release = false;
+  }
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.status._buffer = statuses.data();
+  out.status._length = static_cast<std::uint32_t>(msg.status.size());
+  out.status._maximum = static_cast<std::uint32_t>(statuses.size());
+  out.status._release = false;
+}
+
+PathMessage to_plain(const nav_msgs_msg_dds__Path_& in) {
+  PathMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  for (std::uint32_t i = 0; i < in.poses._length; ++i) {
+    msg.poses.push_back(to_plain(in.poses._buffer[i]));
+  }
+  return msg;
+}
+
+DiagnosticsMessage to_plain(const diagnostic_msgs_msg_dds__DiagnosticArray_& in) {
+  DiagnosticsMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  for (std::uint32_t i = 0; i < in.status._length; ++i) {
+    const diagnostic_msgs_msg_dds__DiagnosticStatus_& d = in.status._buffer[i];
+    DiagnosticStatusMessage m;
+    m.level = d.level;
+    m.name = to_string(d.name);
+    m.message = to_string(d.message);
+    m.hardware_id = to_string(d.hardware_id);
+    for (std::uint32_t k = 0; k < d.values._length; ++k) {
+      m.values.emplace_back(to_string(d.values._buffer[k].key),
+                            to_string(d.values._buffer[k].value));
+    }
+    msg.status.push_back(std::move(m));
+  }
+  return msg;
+}
+
 TfMessage to_plain(const tf2_msgs_msg_dds__TFMessage_& in) {
   TfMessage msg;
   for (std::uint32_t i = 0; i < in.transforms._length; ++i) {

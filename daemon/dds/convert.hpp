@@ -28,10 +28,23 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
 void fill_tf(const TfMessage& msg, tf2_msgs_msg_dds__TFMessage_& out,
              std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms);
 
+/// Points out's poses at `poses` (grown as needed), each stamped and in `frame_id` (which must
+/// outlive the write).
+void fill_path(const PathMessage& msg, char* frame_id, nav_msgs_msg_dds__Path_& out,
+               std::vector<geometry_msgs_msg_dds__PoseStamped_>& poses);
+
+/// Points out's statuses at `statuses` and their key/values at `values` (one vector per status,
+/// grown as needed), their strings into `msg` (valid while msg lives, unchanged).
+void fill_diagnostics(const DiagnosticsMessage& msg, diagnostic_msgs_msg_dds__DiagnosticArray_& out,
+                      std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_>& statuses,
+                      std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>>& values);
+
 OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in);
 PoseMessage to_plain(const geometry_msgs_msg_dds__PoseStamped_& in);
 StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in);
 TfMessage to_plain(const tf2_msgs_msg_dds__TFMessage_& in);
+PathMessage to_plain(const nav_msgs_msg_dds__Path_& in);
+DiagnosticsMessage to_plain(const diagnostic_msgs_msg_dds__DiagnosticArray_& in);
 
 /// A C string field as std::string (Cyclone leaves unset strings null).
 std::string to_string(const char* text);

@@ -3,6 +3,7 @@
 // the build tree. Nothing outside daemon/dds includes this; the daemon uses messages.hpp.
 
 #include "builtin_interfaces.h"
+#include "diagnostic_msgs.h"
 #include "geometry_msgs.h"
 #include "nav_msgs.h"
 #include "posed_msgs.h"

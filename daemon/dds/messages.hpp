@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/time.hpp"
@@ -16,9 +17,10 @@
 namespace posed::dds {
 
 /// The topics posed publishes.
-enum class Topic { kOdom, kPose, kStatus, kTf, kTfStatic };
-inline constexpr std::array kAllTopics = {Topic::kOdom, Topic::kPose, Topic::kStatus, Topic::kTf,
-                                          Topic::kTfStatic};
+enum class Topic { kOdom, kPose, kStatus, kTf, kTfStatic, kPath, kDiagnostics };
+inline constexpr std::array kAllTopics = {Topic::kOdom,       Topic::kPose,     Topic::kStatus,
+                                          Topic::kTf,         Topic::kTfStatic, Topic::kPath,
+                                          Topic::kDiagnostics};
 
 /// DDS topic names: ROS 2 prefixes topics with "rt/", so ROS sees /posed/odom, /tf etc.
 inline constexpr std::string_view kOdomTopic = "rt/posed/odom";
@@ -26,6 +28,8 @@ inline constexpr std::string_view kPoseTopic = "rt/posed/pose";
 inline constexpr std::string_view kStatusTopic = "rt/posed/status";
 inline constexpr std::string_view kTfTopic = "rt/tf";
 inline constexpr std::string_view kTfStaticTopic = "rt/tf_static";
+inline constexpr std::string_view kPathTopic = "rt/posed/path";
+inline constexpr std::string_view kDiagnosticsTopic = "rt/diagnostics";
 
 /// The DDS topic name of `topic`, e.g. "rt/posed/odom".
 constexpr std::string_view topic_name(Topic topic) {
@@ -40,6 +44,10 @@ constexpr std::string_view topic_name(Topic topic) {
       return kTfTopic;
     case Topic::kTfStatic:
       return kTfStaticTopic;
+    case Topic::kPath:
+      return kPathTopic;
+    case Topic::kDiagnostics:
+      return kDiagnosticsTopic;
   }
   return {};
 }
@@ -103,6 +111,29 @@ struct TransformMessage {
 /// tf2_msgs/TFMessage: what rt/tf and rt/tf_static carry.
 struct TfMessage {
   std::vector<TransformMessage> transforms;
+};
+
+/// nav_msgs/Path in the map frame: the trajectory so far, oldest first.
+struct PathMessage {
+  /// time of the newest pose (wall clock, UNIX epoch) [ns]
+  WallTime stamp;
+  std::vector<PoseMessage> poses;
+};
+
+/// diagnostic_msgs/DiagnosticStatus: one component's health, as ROS 2's diagnostic tools read it.
+struct DiagnosticStatusMessage {
+  enum Level : std::uint8_t { kOk = 0, kWarn = 1, kError = 2, kStale = 3 };
+  std::uint8_t level = kOk;
+  std::string name;  ///< "posed: imu"; the aggregator groups by the prefix
+  std::string message;
+  std::string hardware_id;
+  std::vector<std::pair<std::string, std::string>> values;  ///< key, value (with its unit)
+};
+
+/// diagnostic_msgs/DiagnosticArray.
+struct DiagnosticsMessage {
+  WallTime stamp;
+  std::vector<DiagnosticStatusMessage> status;
 };
 
 /// posed_msgs/StreamStatus: health of one input stream.
@@ -247,6 +278,10 @@ struct DdsConfig {
   std::string cyclonedds_xml_path;
   /// create writers for rt/tf and rt/tf_static (publish.tf)
   bool tf = true;
+  /// create a writer for rt/posed/path (publish.path)
+  bool path = true;
+  /// create a writer for rt/diagnostics (publish.diagnostics)
+  bool diagnostics = true;
   /// DDS Security; empty files: none
   DdsSecurityFiles security;
 };

@@ -96,6 +96,10 @@ const dds_topic_descriptor_t& descriptor(Topic topic) {
     case Topic::kTf:
     case Topic::kTfStatic:
       return tf2_msgs_msg_dds__TFMessage__desc;
+    case Topic::kPath:
+      return nav_msgs_msg_dds__Path__desc;
+    case Topic::kDiagnostics:
+      return diagnostic_msgs_msg_dds__DiagnosticArray__desc;
   }
   return nav_msgs_msg_dds__Odometry__desc;
 }

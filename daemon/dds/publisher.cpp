@@ -13,8 +13,10 @@ struct Publisher::Impl {
   dds_entity_t odom_writer = 0;
   dds_entity_t pose_writer = 0;
   dds_entity_t status_writer = 0;
-  dds_entity_t tf_writer = 0;         ///< 0 unless DdsConfig::tf
-  dds_entity_t tf_static_writer = 0;  ///< 0 unless DdsConfig::tf
+  dds_entity_t tf_writer = 0;           ///< 0 unless DdsConfig::tf
+  dds_entity_t tf_static_writer = 0;    ///< 0 unless DdsConfig::tf
+  dds_entity_t path_writer = 0;         ///< 0 unless DdsConfig::path
+  dds_entity_t diagnostics_writer = 0;  ///< 0 unless DdsConfig::diagnostics
   // Frame ids live here for the publisher's lifetime; the samples point into them.
   std::string map_frame;
   std::string base_frame;
@@ -26,6 +28,11 @@ struct Publisher::Impl {
   std::vector<geometry_msgs_msg_dds__TransformStamped_> tf_transforms;
   tf2_msgs_msg_dds__TFMessage_ tf_static_sample{};
   std::vector<geometry_msgs_msg_dds__TransformStamped_> tf_static_transforms;
+  nav_msgs_msg_dds__Path_ path_sample{};
+  std::vector<geometry_msgs_msg_dds__PoseStamped_> path_poses;
+  diagnostic_msgs_msg_dds__DiagnosticArray_ diagnostics_sample{};
+  std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> diagnostics_statuses;
+  std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> diagnostics_values;
   std::atomic<std::uint64_t> write_failures{0};
 
   bool write(dds_entity_t writer, const void* sample) {
@@ -53,11 +60,14 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
     }
     return true;
   };
-  const bool ok = make_writer(Topic::kOdom, impl->odom_writer) &&
-                  make_writer(Topic::kPose, impl->pose_writer) &&
-                  make_writer(Topic::kStatus, impl->status_writer) &&
-                  (!config.tf || (make_writer(Topic::kTf, impl->tf_writer) &&
-                                  make_writer(Topic::kTfStatic, impl->tf_static_writer)));
+  const bool ok =
+      make_writer(Topic::kOdom, impl->odom_writer) &&
+      make_writer(Topic::kPose, impl->pose_writer) &&
+      make_writer(Topic::kStatus, impl->status_writer) &&
+      (!config.tf || (make_writer(Topic::kTf, impl->tf_writer) &&
+                      make_writer(Topic::kTfStatic, impl->tf_static_writer))) &&
+      (!config.path || make_writer(Topic::kPath, impl->path_writer)) &&
+      (!config.diagnostics || make_writer(Topic::kDiagnostics, impl->diagnostics_writer));
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
 
   impl->map_frame = config.map_frame;
@@ -67,6 +77,7 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
   impl->odom_sample.child_frame_id = impl->base_frame.data();
   impl->pose_sample.header.frame_id = map_frame;
   impl->status_sample.header.frame_id = map_frame;
+  impl->diagnostics_sample.header.frame_id = map_frame;
   impl->status_streams.resize(8);  // posed has 4 sensors, some with 2 streams
   return std::unique_ptr<Publisher>(new Publisher(std::move(impl)));
 }
@@ -101,6 +112,19 @@ bool Publisher::publish_tf_static(const TfMessage& msg) {
   return impl_->write(impl_->tf_static_writer, &impl_->tf_static_sample);
 }
 
+bool Publisher::publish_path(const PathMessage& msg) {
+  if (impl_->path_writer == 0) return false;
+  detail::fill_path(msg, impl_->map_frame.data(), impl_->path_sample, impl_->path_poses);
+  return impl_->write(impl_->path_writer, &impl_->path_sample);
+}
+
+bool Publisher::publish_diagnostics(const DiagnosticsMessage& msg) {
+  if (impl_->diagnostics_writer == 0) return false;
+  detail::fill_diagnostics(msg, impl_->diagnostics_sample, impl_->diagnostics_statuses,
+                           impl_->diagnostics_values);
+  return impl_->write(impl_->diagnostics_writer, &impl_->diagnostics_sample);
+}
+
 std::uint32_t Publisher::matched_subscribers(Topic topic) const {
   dds_entity_t writer = 0;
   switch (topic) {
@@ -118,6 +142,12 @@ std::uint32_t Publisher::matched_subscribers(Topic topic) const {
       break;
     case Topic::kTfStatic:
       writer = impl_->tf_static_writer;
+      break;
+    case Topic::kPath:
+      writer = impl_->path_writer;
+      break;
+    case Topic::kDiagnostics:
+      writer = impl_->diagnostics_writer;
       break;
   }
   if (writer == 0) return 0;

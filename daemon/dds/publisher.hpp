@@ -1,7 +1,8 @@
 #pragma once
 // posed's DDS output (DESIGN.md, DDS interface): nav_msgs/Odometry on rt/posed/odom,
 // geometry_msgs/PoseStamped on rt/posed/pose, posed_msgs/Status on rt/posed/status and
-// tf2_msgs/TFMessage on rt/tf and rt/tf_static, with
+// tf2_msgs/TFMessage on rt/tf and rt/tf_static, nav_msgs/Path on rt/posed/path and
+// diagnostic_msgs/DiagnosticArray on rt/diagnostics, with
 // ROS 2's DDS type names, so `ros2 topic echo /posed/odom` or any plain DDS reader receives them.
 
 #include <cstdint>
@@ -33,6 +34,10 @@ class Publisher {
   /// rt/tf_static, transient-local: the last message (all static transforms) reaches readers
   /// that join later.
   bool publish_tf_static(const TfMessage& msg);
+  /// rt/posed/path in the map frame (false, nothing sent, when created without DdsConfig::path).
+  bool publish_path(const PathMessage& msg);
+  /// rt/diagnostics (false, nothing sent, when created without DdsConfig::diagnostics).
+  bool publish_diagnostics(const DiagnosticsMessage& msg);
 
   /// Readers currently matched on `topic` [count]; samples before a match are not delivered
   /// (volatile durability), so tests and benchmarks wait for this first.

@@ -126,6 +126,21 @@ std::size_t Subscriber::take_tf(Topic topic, std::vector<Received<TfMessage>>& o
       topic, out, [](const tf2_msgs_msg_dds__TFMessage_&, Received<TfMessage>&) {});
 }
 
+std::size_t Subscriber::take_path(std::vector<Received<PathMessage>>& out) {
+  return impl_->take<nav_msgs_msg_dds__Path_>(
+      Topic::kPath, out, [](const nav_msgs_msg_dds__Path_& s, Received<PathMessage>& r) {
+        r.frame_id = detail::to_string(s.header.frame_id);
+      });
+}
+
+std::size_t Subscriber::take_diagnostics(std::vector<Received<DiagnosticsMessage>>& out) {
+  return impl_->take<diagnostic_msgs_msg_dds__DiagnosticArray_>(
+      Topic::kDiagnostics, out,
+      [](const diagnostic_msgs_msg_dds__DiagnosticArray_& s, Received<DiagnosticsMessage>& r) {
+        r.frame_id = detail::to_string(s.header.frame_id);
+      });
+}
+
 std::uint32_t Subscriber::matched_publishers(Topic topic) const {
   const dds_entity_t reader = impl_->reader(topic);
   if (reader == 0) return 0;

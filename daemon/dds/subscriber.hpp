@@ -49,6 +49,8 @@ class Subscriber {
   std::size_t take_status(std::vector<Received<StatusMessage>>& out);
   /// rt/tf or rt/tf_static (`topic`); the frames are in each transform.
   std::size_t take_tf(Topic topic, std::vector<Received<TfMessage>>& out);
+  std::size_t take_path(std::vector<Received<PathMessage>>& out);
+  std::size_t take_diagnostics(std::vector<Received<DiagnosticsMessage>>& out);
 
   /// Writers currently matched on `topic` [count].
   std::uint32_t matched_publishers(Topic topic) const;

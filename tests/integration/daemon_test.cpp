@@ -105,28 +105,38 @@ TEST(Daemon, PublishesOdomThatFollowsTheKnownMotionAndStopsOnSigterm) {
   EXPECT_NE(posed.out().find("posed summary"), std::string::npos) << posed.out();
 }
 
-// rt/tf carries map -> odom -> base_link with every pose, so the two transforms chain to the
-// pose posed publishes; rt/tf_static carries base_link -> lidar, camera and thermal from the
-// configured extrinsics, and a reader that joins later still gets it (transient-local).
-TEST(Daemon, PublishesTheTfTreeAndStaticTransformsToLateJoiners) {
+// What ROS 2 tools read: rt/tf carries map -> odom -> base_link with every pose, so the two
+// transforms chain to the pose posed publishes; rt/tf_static carries base_link -> lidar, camera
+// and thermal from the configured extrinsics, and a reader that joins later still gets it
+// (transient-local); rt/posed/path ends at a published pose; rt/diagnostics has a status per
+// stream and one for the estimator.
+TEST(Daemon, PublishesTfPathAndDiagnosticsAsRos2ToolsExpect) {
   TempDir dir;
   const std::string config = dir.write("posed.yaml", demo_like_config());
   std::string error;
-  const std::array topics = {dds::Topic::kPose, dds::Topic::kTf};
+  const std::array topics = {dds::Topic::kPose, dds::Topic::kTf, dds::Topic::kPath,
+                             dds::Topic::kDiagnostics};
   auto reader = dds::Subscriber::create(reader_config(), topics, error);
   ASSERT_TRUE(reader) << error;
 
   PosedProcess posed(posed_argv(config), {}, dir);
   std::vector<dds::Received<dds::PoseMessage>> poses;
   std::vector<dds::Received<dds::TfMessage>> tf;
+  std::vector<dds::Received<dds::PathMessage>> paths;
+  std::vector<dds::Received<dds::DiagnosticsMessage>> diagnostics;
   const auto deadline = std::chrono::steady_clock::now() + 20s;
-  while (tf.size() < 30 && std::chrono::steady_clock::now() < deadline) {
+  while ((tf.size() < 30 || paths.size() < 2 || diagnostics.size() < 2) &&
+         std::chrono::steady_clock::now() < deadline) {
     reader->wait(Duration::from_ms(100));
     reader->take_pose(poses);
     reader->take_tf(dds::Topic::kTf, tf);
+    reader->take_path(paths);
+    reader->take_diagnostics(diagnostics);
   }
   reader->take_pose(poses);
   ASSERT_GE(tf.size(), 30u) << "stderr:\n" << posed.err();
+  ASSERT_GE(paths.size(), 2u);
+  ASSERT_GE(diagnostics.size(), 2u);
 
   std::map<std::int64_t, const dds::PoseMessage*> pose_at;
   for (const auto& p : poses) pose_at[p.msg.stamp.ns] = &p.msg;
@@ -151,6 +161,29 @@ TEST(Daemon, PublishesTheTfTreeAndStaticTransformsToLateJoiners) {
               1e-9);
   }
   EXPECT_GT(matched, tf.size() / 2) << "tf stamps are not the poses' stamps";
+
+  // The path: in map, growing, its newest pose one that went out on rt/posed/pose.
+  const auto& path = paths.back();
+  EXPECT_EQ(path.frame_id, "map");
+  ASSERT_FALSE(path.msg.poses.empty());
+  EXPECT_GE(path.msg.poses.size(), paths.front().msg.poses.size());
+  const auto newest = pose_at.find(path.msg.poses.back().stamp.ns);
+  ASSERT_NE(newest, pose_at.end());
+  EXPECT_EQ(newest->second->p_map_base_m, path.msg.poses.back().p_map_base_m);
+
+  // Diagnostics: the IMU stream healthy, with its figures, and the estimator.
+  const auto& statuses = diagnostics.back().msg.status;
+  const auto named = [&](const std::string& name) {
+    return std::find_if(statuses.begin(), statuses.end(),
+                        [&](const dds::DiagnosticStatusMessage& d) { return d.name == name; });
+  };
+  const auto imu = named("posed: imu");
+  ASSERT_NE(imu, statuses.end());
+  EXPECT_EQ(imu->level, dds::DiagnosticStatusMessage::kOk) << imu->message;
+  EXPECT_NE(std::find_if(imu->values.begin(), imu->values.end(),
+                         [](const auto& kv) { return kv.first == "decoded" && kv.second != "0"; }),
+            imu->values.end());
+  EXPECT_NE(named("posed: estimator"), statuses.end());
 
   // A reader that joins now, long after posed sent its static transforms, still gets them.
   const std::array static_topic = {dds::Topic::kTfStatic};

@@ -208,6 +208,51 @@ void print_tf(const dds::Received<dds::TfMessage>& r, bool as_csv) {
   }
 }
 
+void print_path_header_csv() {
+  std::printf("stamp_s,receive_s,latency_ms,frame_id,poses,x_m,y_m,z_m\n");
+}
+
+/// One line per message: how many poses, and the newest.
+void print_path(const dds::Received<dds::PathMessage>& r, bool as_csv) {
+  const auto& m = r.msg;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  const Eigen::Vector3d p = m.poses.empty() ? Eigen::Vector3d::Zero() : m.poses.back().p_map_base_m;
+  if (as_csv) {
+    std::printf("%s,%s,%.3f,%s,%zu,%.6f,%.6f,%.6f\n", stamp_text(m.stamp).c_str(),
+                stamp_text(r.received_wall).c_str(), lat, csv(r.frame_id).c_str(), m.poses.size(),
+                p.x(), p.y(), p.z());
+    return;
+  }
+  std::printf("path %s s in %s  %zu poses, newest p [%.3f %.3f %.3f] m\n",
+              stamp_text(m.stamp).c_str(), r.frame_id.c_str(), m.poses.size(), p.x(), p.y(), p.z());
+}
+
+void print_diagnostics_header_csv() {
+  std::printf("stamp_s,receive_s,latency_ms,level,name,message,hardware_id,values\n");
+}
+
+/// One line per status: level, name, message, then key=value pairs.
+void print_diagnostics(const dds::Received<dds::DiagnosticsMessage>& r, bool as_csv) {
+  static const char* kLevels[] = {"OK", "WARN", "ERROR", "STALE"};
+  const auto& m = r.msg;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  for (const auto& d : m.status) {
+    const char* level = d.level < 4 ? kLevels[d.level] : "?";
+    std::string values;
+    for (const auto& [key, value] : d.values) {
+      values += (values.empty() ? "" : as_csv ? ";" : "  ") + key + "=" + value;
+    }
+    if (as_csv) {
+      std::printf("%s,%s,%.3f,%s,%s,%s,%s,%s\n", stamp_text(m.stamp).c_str(),
+                  stamp_text(r.received_wall).c_str(), lat, level, csv(d.name).c_str(),
+                  csv(d.message).c_str(), csv(d.hardware_id).c_str(), csv(values).c_str());
+    } else {
+      std::printf("diagnostics %s s  %-5s %s: %s  [%s]\n", stamp_text(m.stamp).c_str(), level,
+                  d.name.c_str(), d.message.c_str(), values.c_str());
+    }
+  }
+}
+
 void print_status_header_csv() {
   std::printf(
       "stamp_s,receive_s,latency_ms,version,estimator_mode,uptime_s,summary,stream,rate_hz,"
@@ -332,11 +377,15 @@ void write_tum(std::FILE* tum, const dds::Received<dds::PoseMessage>& r) {
 }
 void write_tum(std::FILE*, const dds::Received<dds::StatusMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::TfMessage>&) {}
+void write_tum(std::FILE*, const dds::Received<dds::PathMessage>&) {}
+void write_tum(std::FILE*, const dds::Received<dds::DiagnosticsMessage>&) {}
 
 /// The stamp a message's latency is measured from (a tf message: its first transform's).
 WallTime stamp_of(const dds::OdomMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::PoseMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::StatusMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::PathMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::DiagnosticsMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::TfMessage& m) {
   return m.transforms.empty() ? WallTime{} : m.transforms.front().stamp;
 }
@@ -404,8 +453,9 @@ int run_echo(int argc, char** argv) {
   dds::Topic topic = dds::Topic::kOdom;
   if (!dds::parse_topic(topic_arg, topic)) {
     std::fprintf(stderr,
-                 "posectl echo: unknown topic '%s' (expected odom, pose, status, tf, tf_static "
-                 "or their DDS names rt/posed/{odom,pose,status}, rt/tf, rt/tf_static)\n",
+                 "posectl echo: unknown topic '%s' (expected odom, pose, status, path, tf, "
+                 "tf_static, diagnostics, or their DDS names rt/posed/{odom,pose,status,path}, "
+                 "rt/tf, rt/tf_static, rt/diagnostics)\n",
                  topic_arg.c_str());
     return 2;
   }
@@ -445,6 +495,8 @@ int run_echo(int argc, char** argv) {
     if (topic == dds::Topic::kPose) print_pose_header_csv();
     if (topic == dds::Topic::kStatus) print_status_header_csv();
     if (topic == dds::Topic::kTf || topic == dds::Topic::kTfStatic) print_tf_header_csv();
+    if (topic == dds::Topic::kPath) print_path_header_csv();
+    if (topic == dds::Topic::kDiagnostics) print_diagnostics_header_csv();
   }
   std::fprintf(stderr, "posectl echo: listening on %s (domain %u)\n", topic_name.c_str(), domain);
 
@@ -483,6 +535,14 @@ int run_echo(int argc, char** argv) {
       case dds::Topic::kTfStatic:
         drain<dds::TfMessage>([&](auto& v) { subscriber->take_tf(topic, v); }, print_tf, as_csv,
                               nullptr, stats, count);
+        break;
+      case dds::Topic::kPath:
+        drain<dds::PathMessage>([&](auto& v) { subscriber->take_path(v); }, print_path, as_csv,
+                                nullptr, stats, count);
+        break;
+      case dds::Topic::kDiagnostics:
+        drain<dds::DiagnosticsMessage>([&](auto& v) { subscriber->take_diagnostics(v); },
+                                       print_diagnostics, as_csv, nullptr, stats, count);
         break;
     }
   }

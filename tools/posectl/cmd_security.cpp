@@ -1,10 +1,11 @@
 // posectl security init DIR: a DDS Security keystore for posed in SROS2's layout
 // (tools/posectl/keystore.hpp): a CA, the governance document, and the enclaves "posed" (publishes
-// rt/posed/*, rt/tf and rt/tf_static) and "posectl" (reads them), plus one reader enclave per
-// --reader NAME for the programs that consume posed's poses. Run again with other --reader names to add enclaves signed
-// by the same CA. posed takes an enclave with `dds.security.enclave: DIR/enclaves/posed`, posectl
-// echo with `--enclave DIR/enclaves/posectl` (docs/security.md).
-// Exit codes: 0 written, 1 a file could not be made, 2 bad arguments.
+// rt/posed/*, rt/tf, rt/tf_static and rt/diagnostics) and "posectl" (reads them), plus one reader
+// enclave per
+// --reader NAME for the programs that consume posed's poses. Run again with other --reader names to
+// add enclaves signed by the same CA. posed takes an enclave with `dds.security.enclave:
+// DIR/enclaves/posed`, posectl echo with `--enclave DIR/enclaves/posectl` (docs/security.md). Exit
+// codes: 0 written, 1 a file could not be made, 2 bad arguments.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -32,9 +33,10 @@ int run_security(int argc, char** argv) {
       ->check(CLI::Range(0, 230));
   init->add_option("--days", days, "validity of certificates and permissions [days]")
       ->check(CLI::Range(1, 36500));
-  init->add_option("--reader", readers,
-                   "another enclave allowed to read rt/posed/*, rt/tf and rt/tf_static "
-                   "(repeatable), e.g. a controller");
+  init->add_option(
+      "--reader", readers,
+      "another enclave allowed to read rt/posed/*, rt/tf, rt/tf_static and rt/diagnostics "
+      "(repeatable), e.g. a controller");
   CLI11_PARSE(app, argc, argv);
 
   KeystoreSpec spec;
@@ -61,7 +63,8 @@ int run_security(int argc, char** argv) {
               domain_id < 0 ? "every domain" : ("domain " + std::to_string(domain_id)).c_str());
   for (const EnclaveSpec& e : spec.enclaves) {
     std::printf("  enclaves/%-10s %s %s\n", e.name.c_str(),
-                e.publish.empty() ? "reads" : "publishes", "rt/posed/*, rt/tf, rt/tf_static");
+                e.publish.empty() ? "reads" : "publishes",
+                "rt/posed/*, rt/tf, rt/tf_static, rt/diagnostics");
   }
   return 0;
 }

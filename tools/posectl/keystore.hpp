@@ -15,7 +15,8 @@
 namespace posed::posectl {
 
 /// What posed writes and its readers read: its own topics and the tf tree.
-inline const std::vector<std::string> kPosedTopics = {"rt/posed/*", "rt/tf", "rt/tf_static"};
+inline const std::vector<std::string> kPosedTopics = {"rt/posed/*", "rt/tf", "rt/tf_static",
+                                                      "rt/diagnostics"};
 
 struct EnclaveSpec {
   std::string name;                  ///< "posed" -> enclaves/posed, subject CN=/posed

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/dds/convert.hpp"
 #include "daemon/dds/generated_types.hpp"
 #include "daemon/dds/participant.hpp"
 #include "tests/unit/dds/test_domain.hpp"
@@ -328,6 +329,88 @@ TEST_F(CdrLoop, StatusRoundTripsWithStreams) {
   expect_stream_eq(out.streams._buffer[0], streams[0]);
   expect_stream_eq(out.streams._buffer[1], streams[1]);
   free_sample(posed_msgs_msg_dds__Status__desc, out);
+}
+
+// The ROS 2 tool topics through the same fill_* the Publisher uses and back through Cyclone's
+// serializer: sequences, nested sequences and strings land where a ROS 2 reader looks.
+TEST_F(CdrLoop, TfPathAndDiagnosticsRoundTripThroughTheirFillers) {
+  TfMessage tf;
+  tf.transforms.resize(2);
+  tf.transforms[0] = {WallTime::from_ns(1'500'000'000),
+                      "map",
+                      "odom",
+                      {1, 2, 3},
+                      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()))};
+  tf.transforms[1] = {WallTime::from_ns(2'000'000'001),
+                      "odom",
+                      "base_link",
+                      {-4, 5, 0.5},
+                      Eigen::Quaterniond::Identity()};
+  tf2_msgs_msg_dds__TFMessage_ tf_in{};
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
+  detail::fill_tf(tf, tf_in, transforms);
+  tf2_msgs_msg_dds__TFMessage_ tf_out{};
+  round_trip(tf2_msgs_msg_dds__TFMessage__desc, tf_in, tf_out);
+  const TfMessage tf_back = detail::to_plain(tf_out);
+  ASSERT_EQ(tf_back.transforms.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(tf_back.transforms[i].stamp, tf.transforms[i].stamp);
+    EXPECT_EQ(tf_back.transforms[i].parent_frame, tf.transforms[i].parent_frame);
+    EXPECT_EQ(tf_back.transforms[i].child_frame, tf.transforms[i].child_frame);
+    EXPECT_EQ(tf_back.transforms[i].p_parent_child_m, tf.transforms[i].p_parent_child_m);
+    EXPECT_EQ(tf_back.transforms[i].q_parent_child.coeffs(),
+              tf.transforms[i].q_parent_child.coeffs());
+  }
+  free_sample(tf2_msgs_msg_dds__TFMessage__desc, tf_out);
+
+  PathMessage path;
+  path.stamp = WallTime::from_ns(3'000'000'000);
+  for (int i = 0; i < 3; ++i) {
+    PoseMessage p;
+    p.stamp = WallTime::from_ns(1'000'000'000LL * (i + 1));
+    p.p_map_base_m = {static_cast<double>(i), 0, 0};
+    path.poses.push_back(p);
+  }
+  char map[] = "map";
+  nav_msgs_msg_dds__Path_ path_in{};
+  std::vector<geometry_msgs_msg_dds__PoseStamped_> poses;
+  detail::fill_path(path, map, path_in, poses);
+  nav_msgs_msg_dds__Path_ path_out{};
+  round_trip(nav_msgs_msg_dds__Path__desc, path_in, path_out);
+  EXPECT_STREQ(path_out.header.frame_id, "map");
+  ASSERT_EQ(path_out.poses._length, 3u);
+  EXPECT_STREQ(path_out.poses._buffer[2].header.frame_id, "map");
+  const PathMessage path_back = detail::to_plain(path_out);
+  EXPECT_EQ(path_back.stamp, path.stamp);
+  EXPECT_EQ(path_back.poses[2].stamp, path.poses[2].stamp);
+  EXPECT_EQ(path_back.poses[2].p_map_base_m, path.poses[2].p_map_base_m);
+  free_sample(nav_msgs_msg_dds__Path__desc, path_out);
+
+  DiagnosticsMessage diag;
+  diag.stamp = WallTime::from_ns(4'000'000'000);
+  diag.status.push_back({DiagnosticStatusMessage::kWarn,
+                         "posed: lidar",
+                         "degraded",
+                         "lidar",
+                         {{"rate", "9.9 Hz"}, {"malformed", "12"}}});
+  diag.status.push_back(
+      {DiagnosticStatusMessage::kOk, "posed: estimator", "lidar_inertial", "fusion core", {}});
+  diagnostic_msgs_msg_dds__DiagnosticArray_ diag_in{};
+  std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> statuses;
+  std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> values;
+  detail::fill_diagnostics(diag, diag_in, statuses, values);
+  diag_in.header.frame_id = map;
+  diagnostic_msgs_msg_dds__DiagnosticArray_ diag_out{};
+  round_trip(diagnostic_msgs_msg_dds__DiagnosticArray__desc, diag_in, diag_out);
+  const DiagnosticsMessage diag_back = detail::to_plain(diag_out);
+  ASSERT_EQ(diag_back.status.size(), 2u);
+  EXPECT_EQ(diag_back.status[0].level, DiagnosticStatusMessage::kWarn);
+  EXPECT_EQ(diag_back.status[0].name, "posed: lidar");
+  EXPECT_EQ(diag_back.status[0].hardware_id, "lidar");
+  EXPECT_EQ(diag_back.status[0].values, diag.status[0].values);
+  EXPECT_EQ(diag_back.status[1].message, "lidar_inertial");
+  EXPECT_TRUE(diag_back.status[1].values.empty());
+  free_sample(diagnostic_msgs_msg_dds__DiagnosticArray__desc, diag_out);
 }
 
 }  // namespace

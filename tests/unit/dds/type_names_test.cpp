@@ -36,6 +36,14 @@ TEST(DdsTypeNames, MatchRosidlDdsNames) {
   EXPECT_STREQ(posed_msgs_msg_dds__StreamStatus__desc.m_typename,
                "posed_msgs::msg::dds_::StreamStatus_");
   EXPECT_STREQ(posed_msgs_msg_dds__Status__desc.m_typename, "posed_msgs::msg::dds_::Status_");
+  EXPECT_STREQ(geometry_msgs_msg_dds__TransformStamped__desc.m_typename,
+               "geometry_msgs::msg::dds_::TransformStamped_");
+  EXPECT_STREQ(tf2_msgs_msg_dds__TFMessage__desc.m_typename, "tf2_msgs::msg::dds_::TFMessage_");
+  EXPECT_STREQ(nav_msgs_msg_dds__Path__desc.m_typename, "nav_msgs::msg::dds_::Path_");
+  EXPECT_STREQ(diagnostic_msgs_msg_dds__DiagnosticArray__desc.m_typename,
+               "diagnostic_msgs::msg::dds_::DiagnosticArray_");
+  EXPECT_STREQ(diagnostic_msgs_msg_dds__DiagnosticStatus__desc.m_typename,
+               "diagnostic_msgs::msg::dds_::DiagnosticStatus_");
 }
 
 TEST(DdsTypeNames, ROS2TypesHaveNoKey) {
@@ -49,6 +57,10 @@ TEST(DdsTopicNames, AreRos2Mangled) {
   EXPECT_EQ(topic_name(Topic::kOdom), "rt/posed/odom");
   EXPECT_EQ(topic_name(Topic::kPose), "rt/posed/pose");
   EXPECT_EQ(topic_name(Topic::kStatus), "rt/posed/status");
+  EXPECT_EQ(topic_name(Topic::kTf), "rt/tf");
+  EXPECT_EQ(topic_name(Topic::kTfStatic), "rt/tf_static");
+  EXPECT_EQ(topic_name(Topic::kPath), "rt/posed/path");
+  EXPECT_EQ(topic_name(Topic::kDiagnostics), "rt/diagnostics");
 }
 
 TEST(DdsTopicNames, ParseAcceptsShortRosAndDdsNames) {
@@ -59,6 +71,10 @@ TEST(DdsTopicNames, ParseAcceptsShortRosAndDdsNames) {
   EXPECT_EQ(t, Topic::kStatus);
   EXPECT_TRUE(parse_topic("rt/posed/odom", t));
   EXPECT_EQ(t, Topic::kOdom);
+  EXPECT_TRUE(parse_topic("/tf_static", t));
+  EXPECT_EQ(t, Topic::kTfStatic);
+  EXPECT_TRUE(parse_topic("diagnostics", t));
+  EXPECT_EQ(t, Topic::kDiagnostics);
   EXPECT_FALSE(parse_topic("rt/posed/odometry", t));
   EXPECT_FALSE(parse_topic("", t));
 }
@@ -72,7 +88,11 @@ TEST(DdsTopicNames, TopicsCarryTheRosTypeName) {
     const char* type;
   } cases[] = {{Topic::kOdom, "nav_msgs::msg::dds_::Odometry_"},
                {Topic::kPose, "geometry_msgs::msg::dds_::PoseStamped_"},
-               {Topic::kStatus, "posed_msgs::msg::dds_::Status_"}};
+               {Topic::kStatus, "posed_msgs::msg::dds_::Status_"},
+               {Topic::kTf, "tf2_msgs::msg::dds_::TFMessage_"},
+               {Topic::kTfStatic, "tf2_msgs::msg::dds_::TFMessage_"},
+               {Topic::kPath, "nav_msgs::msg::dds_::Path_"},
+               {Topic::kDiagnostics, "diagnostic_msgs::msg::dds_::DiagnosticArray_"}};
   for (const auto& c : cases) {
     const dds_entity_t topic = detail::create_topic(participant->handle(), c.topic, error);
     ASSERT_GT(topic, 0) << error;

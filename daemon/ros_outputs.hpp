@@ -1,0 +1,42 @@
+#pragma once
+// What ROS 2 tools expect next to posed's own topics, built from its states and status (pure
+// functions; PoseSinks publishes them): the tf tree (rt/tf, rt/tf_static), the path
+// (rt/posed/path) and per-component health (rt/diagnostics).
+
+#include <cstdint>
+#include <vector>
+
+#include "core/estimator/nav_state.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/dds/messages.hpp"
+#include "daemon/pipeline/pipeline_status.hpp"
+
+namespace posed {
+
+/// base_link -> lidar, colour camera and thermal camera frames from the configured extrinsics.
+dds::TfMessage static_transforms(const config::PosedConfig& config, WallTime stamp);
+
+/// map -> odom (identity: no map correction exists yet) -> base_link at `s`.
+dds::TfMessage tf_tree(const config::DdsSection& dds, const NavState& s, WallTime stamp);
+
+/// rt/diagnostics: one status per input stream ("posed: imu", ...) and one for the estimator,
+/// levels as diagnostic_msgs defines them.
+dds::DiagnosticsMessage diagnostics(const pipeline::PipelineStatus& st, WallTime stamp);
+
+/// The trajectory for rt/posed/path: poses kept at least `min_step_m` apart, and always ending at
+/// the newest; past `max_poses`, every other old pose is dropped, so the whole run stays in the
+/// path at a coarser spacing and the message size stays bounded.
+class PathBuilder {
+ public:
+  PathBuilder(double min_step_m, std::size_t max_poses)
+      : min_step_m_(min_step_m), max_poses_(max_poses) {}
+  void add(const dds::PoseMessage& pose);
+  const dds::PathMessage& path() const { return path_; }
+
+ private:
+  double min_step_m_;
+  std::size_t max_poses_;
+  dds::PathMessage path_;
+};
+
+}  // namespace posed
