@@ -1,5 +1,6 @@
 #include "daemon/dds/publisher.hpp"
 
+#include <array>
 #include <atomic>
 #include <vector>
 
@@ -10,13 +11,8 @@ namespace posed::dds {
 
 struct Publisher::Impl {
   std::unique_ptr<detail::Participant> participant;
-  dds_entity_t odom_writer = 0;
-  dds_entity_t pose_writer = 0;
-  dds_entity_t status_writer = 0;
-  dds_entity_t tf_writer = 0;           ///< 0 unless DdsConfig::tf
-  dds_entity_t tf_static_writer = 0;    ///< 0 unless DdsConfig::tf
-  dds_entity_t path_writer = 0;         ///< 0 unless DdsConfig::path
-  dds_entity_t diagnostics_writer = 0;  ///< 0 unless DdsConfig::diagnostics
+  /// writer per Topic (index = enum value); 0 for a topic the DdsConfig leaves off
+  std::array<dds_entity_t, kAllTopics.size()> writers{};
   // Frame ids live here for the publisher's lifetime; the samples point into them.
   std::string map_frame;
   std::string base_frame;
@@ -35,8 +31,12 @@ struct Publisher::Impl {
   std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> diagnostics_values;
   std::atomic<std::uint64_t> write_failures{0};
 
-  bool write(dds_entity_t writer, const void* sample) {
-    if (dds_write(writer, sample) == DDS_RETCODE_OK) return true;
+  dds_entity_t& writer(Topic topic) { return writers[static_cast<std::size_t>(topic)]; }
+
+  /// false (nothing sent) for a topic without a writer or a write Cyclone rejected.
+  bool write(Topic topic, const void* sample) {
+    if (writer(topic) == 0) return false;
+    if (dds_write(writer(topic), sample) == DDS_RETCODE_OK) return true;
     write_failures.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
@@ -48,10 +48,11 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
   if (!impl->participant) return nullptr;
   const dds_entity_t participant = impl->participant->handle();
 
-  const auto make_writer = [&](Topic topic, dds_entity_t& writer) {
+  const auto make_writer = [&](Topic topic) {
     const dds_entity_t t = detail::create_topic(participant, topic, error);
     if (t < 0) return false;
     dds_qos_t* qos = detail::make_topic_qos(topic);
+    dds_entity_t& writer = impl->writer(topic);
     writer = dds_create_writer(participant, t, qos, nullptr);
     dds_delete_qos(qos);
     if (writer < 0) {
@@ -60,14 +61,11 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
     }
     return true;
   };
-  const bool ok =
-      make_writer(Topic::kOdom, impl->odom_writer) &&
-      make_writer(Topic::kPose, impl->pose_writer) &&
-      make_writer(Topic::kStatus, impl->status_writer) &&
-      (!config.tf || (make_writer(Topic::kTf, impl->tf_writer) &&
-                      make_writer(Topic::kTfStatic, impl->tf_static_writer))) &&
-      (!config.path || make_writer(Topic::kPath, impl->path_writer)) &&
-      (!config.diagnostics || make_writer(Topic::kDiagnostics, impl->diagnostics_writer));
+  const bool ok = make_writer(Topic::kOdom) && make_writer(Topic::kPose) &&
+                  make_writer(Topic::kStatus) &&
+                  (!config.tf || (make_writer(Topic::kTf) && make_writer(Topic::kTfStatic))) &&
+                  (!config.path || make_writer(Topic::kPath)) &&
+                  (!config.diagnostics || make_writer(Topic::kDiagnostics));
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
 
   impl->map_frame = config.map_frame;
@@ -87,69 +85,42 @@ Publisher::~Publisher() = default;
 
 bool Publisher::publish_odom(const OdomMessage& msg) {
   detail::fill_odom(msg, impl_->odom_sample);
-  return impl_->write(impl_->odom_writer, &impl_->odom_sample);
+  return impl_->write(Topic::kOdom, &impl_->odom_sample);
 }
 
 bool Publisher::publish_pose(const PoseMessage& msg) {
   detail::fill_pose(msg, impl_->pose_sample);
-  return impl_->write(impl_->pose_writer, &impl_->pose_sample);
+  return impl_->write(Topic::kPose, &impl_->pose_sample);
 }
 
 bool Publisher::publish_status(const StatusMessage& msg) {
   detail::fill_status(msg, impl_->status_sample, impl_->status_streams);
-  return impl_->write(impl_->status_writer, &impl_->status_sample);
+  return impl_->write(Topic::kStatus, &impl_->status_sample);
 }
 
 bool Publisher::publish_tf(const TfMessage& msg) {
-  if (impl_->tf_writer == 0) return false;
   detail::fill_tf(msg, impl_->tf_sample, impl_->tf_transforms);
-  return impl_->write(impl_->tf_writer, &impl_->tf_sample);
+  return impl_->write(Topic::kTf, &impl_->tf_sample);
 }
 
 bool Publisher::publish_tf_static(const TfMessage& msg) {
-  if (impl_->tf_static_writer == 0) return false;
   detail::fill_tf(msg, impl_->tf_static_sample, impl_->tf_static_transforms);
-  return impl_->write(impl_->tf_static_writer, &impl_->tf_static_sample);
+  return impl_->write(Topic::kTfStatic, &impl_->tf_static_sample);
 }
 
 bool Publisher::publish_path(const PathMessage& msg) {
-  if (impl_->path_writer == 0) return false;
   detail::fill_path(msg, impl_->map_frame.data(), impl_->path_sample, impl_->path_poses);
-  return impl_->write(impl_->path_writer, &impl_->path_sample);
+  return impl_->write(Topic::kPath, &impl_->path_sample);
 }
 
 bool Publisher::publish_diagnostics(const DiagnosticsMessage& msg) {
-  if (impl_->diagnostics_writer == 0) return false;
   detail::fill_diagnostics(msg, impl_->diagnostics_sample, impl_->diagnostics_statuses,
                            impl_->diagnostics_values);
-  return impl_->write(impl_->diagnostics_writer, &impl_->diagnostics_sample);
+  return impl_->write(Topic::kDiagnostics, &impl_->diagnostics_sample);
 }
 
 std::uint32_t Publisher::matched_subscribers(Topic topic) const {
-  dds_entity_t writer = 0;
-  switch (topic) {
-    case Topic::kOdom:
-      writer = impl_->odom_writer;
-      break;
-    case Topic::kPose:
-      writer = impl_->pose_writer;
-      break;
-    case Topic::kStatus:
-      writer = impl_->status_writer;
-      break;
-    case Topic::kTf:
-      writer = impl_->tf_writer;
-      break;
-    case Topic::kTfStatic:
-      writer = impl_->tf_static_writer;
-      break;
-    case Topic::kPath:
-      writer = impl_->path_writer;
-      break;
-    case Topic::kDiagnostics:
-      writer = impl_->diagnostics_writer;
-      break;
-  }
+  const dds_entity_t writer = impl_->writers[static_cast<std::size_t>(topic)];
   if (writer == 0) return 0;
   dds_publication_matched_status_t status{};
   if (dds_get_publication_matched_status(writer, &status) != DDS_RETCODE_OK) return 0;
