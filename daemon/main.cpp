@@ -36,6 +36,11 @@ int main(int argc, char** argv) noexcept try {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--record", options.record_path,
                  "record every sensor's raw bytes and the poses to this MCAP file");
+  app.add_option("--record-outputs", options.record_outputs,
+                 "with --record: which DDS outputs to record too, as ROS 2 (ros2msg/CDR) channels "
+                 "Foxglove opens: comma-separated from tf, tf_static, path, diagnostics, status, "
+                 "cloud, map; all; or none (clouds are ~0.7 MB a scan)")
+      ->capture_default_str();
   app.add_option("--save-map", options.map_path,
                  "at the end of the run (or on SIGTERM), write the lidar map to this PCD file "
                  "(binary, x y z in the map frame [m]) and the keyframe poses to "

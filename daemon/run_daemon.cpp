@@ -13,9 +13,11 @@
 #include <thread>
 
 #include "daemon/build_info.hpp"
+#include "daemon/cloud_output.hpp"
 #include "daemon/dds/publisher.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
+#include "daemon/output_tap.hpp"
 #include "daemon/pipeline/camera_calibration.hpp"
 #include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/latency_histogram.hpp"
@@ -105,6 +107,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds_config.security = dds_security_files(config.dds.security);
   dds_config.tf = config.publish.tf;
   dds_config.path = config.publish.path;
+  dds_config.cloud = config.publish.cloud;
+  dds_config.map = config.publish.map;
   dds_config.diagnostics = config.publish.diagnostics;
   std::string error;
   std::unique_ptr<dds::Publisher> publisher;
@@ -157,6 +161,20 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     POSED_LOG_INFO("recording raw streams and poses to %s", options.record_path.c_str());
   }
 
+  // The DDS outputs beside DDS: into the recording as ros2msg channels.
+  std::vector<dds::Topic> record_outputs;
+  if (recorder && !parse_record_outputs(options.record_outputs, record_outputs, error)) {
+    POSED_LOG_ERROR("%s", error.c_str());
+    return 1;
+  }
+  OutputTap output_tap(recorder.get(), record_outputs);
+  if (publisher) publisher->set_tap(&output_tap);
+  // Point clouds are built and written off the fusion thread, only with a lidar to make them.
+  std::unique_ptr<CloudOutput> cloud_output;
+  if (publisher && built.sources.lidar && (config.publish.cloud || config.publish.map)) {
+    cloud_output = std::make_unique<CloudOutput>(config, *publisher, to_wall);
+  }
+
   // Stamps are this host's clock now live and in a replay with --live-stamps; otherwise a
   // recording's, and how late a message is cannot be told from them.
   PoseSinks sinks(config, publisher.get(), recorder.get(), to_wall, started,
@@ -164,6 +182,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   sinks.static_transforms();
   pipeline::PipelineOutputs outputs;
   outputs.keep_map = !options.map_path.empty();
+  outputs.scan_observer = cloud_output.get();
   outputs.on_odom = [&sinks](const NavState& s) { sinks.odom(s); };
   outputs.on_state = [&sinks](const NavState& s) { sinks.state(s); };
   outputs.on_status = [&sinks](const pipeline::PipelineStatus& st) { sinks.status(st); };
@@ -254,6 +273,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     }
   }
   pipe.join();
+  if (cloud_output) cloud_output->stop();  // its last writes reach the recording too
   if (recorder && !recorder->close()) {
     POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());
     exit_code = 1;
@@ -262,9 +282,19 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   if (!options.map_path.empty() && !save_map(pipe, options.map_path, to_wall, map_line))
     exit_code = 1;
 
-  const RunSummary summary{config,         options,          pipe,           sinks,
-                           started,        pipeline_started, replay_streams, built_has_lidar,
-                           recorder.get(), map_line,         synthetic,      publisher != nullptr};
+  const RunSummary summary{config,
+                           options,
+                           pipe,
+                           sinks,
+                           started,
+                           pipeline_started,
+                           replay_streams,
+                           built_has_lidar,
+                           recorder.get(),
+                           map_line,
+                           synthetic,
+                           publisher != nullptr,
+                           cloud_output.get()};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

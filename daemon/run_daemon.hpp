@@ -16,6 +16,8 @@ struct RunOptions {
   double duration_s = 0;
   /// record every Source's raw bytes, and the poses, to this MCAP file; empty = no recording
   std::string record_path;
+  /// with record_path: the DDS outputs recorded too, as ros2msg channels (parse_record_outputs)
+  std::string record_outputs = "tf,tf_static,path,diagnostics,status";
   /// at the end of the run, write the lidar map here (PCD) and the keyframe poses next to it
   /// (keyframes_path_for()); empty = keep no map
   std::string map_path;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "daemon/cloud_output.hpp"
 #include "daemon/estimator_summary.hpp"
 #include "daemon/pipeline/pipeline.hpp"
 #include "drivers/common/host_clock.hpp"
@@ -120,6 +121,16 @@ bool print_run_summary(const RunSummary& r) {
                 r.sinks.odom_latency().line(r.sinks.live_clock()).c_str());
     std::printf("                      %s\n",
                 r.sinks.pose_latency().line(r.sinks.live_clock()).c_str());
+    if (r.clouds != nullptr) {
+      const CloudOutputCounters c = r.clouds->counters();
+      std::printf(
+          "  point clouds        %llu rt/posed/cloud (last %.2f MB; %llu replaced by a newer "
+          "scan before the write), %llu rt/posed/map (last %.2f MB)%s\n",
+          static_cast<unsigned long long>(c.clouds), static_cast<double>(c.last_cloud_bytes) / 1e6,
+          static_cast<unsigned long long>(c.clouds_replaced),
+          static_cast<unsigned long long>(c.maps), static_cast<double>(c.last_map_bytes) / 1e6,
+          c.failed ? " (some writes failed)" : "");
+    }
     const std::string_view mode = r.pipe.odometry_mode();
     std::printf("  odometry            %s\n",
                 mode == "imu_thread"

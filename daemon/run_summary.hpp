@@ -22,6 +22,8 @@ namespace drivers::recording {
 class Recorder;
 }
 
+class CloudOutput;
+
 struct RunSummary {
   const config::PosedConfig& config;
   const RunOptions& options;
@@ -34,7 +36,8 @@ struct RunSummary {
   const drivers::recording::Recorder* recorder = nullptr;  ///< closed; null: not recording
   std::string map_line;                                    ///< "" without --save-map
   const drivers::SyntheticImuSource* synthetic = nullptr;  ///< the truth of a synthetic IMU
-  bool published = true;  ///< a DDS participant published (false: an offline run)
+  bool published = true;                ///< a DDS participant published (false: an offline run)
+  const CloudOutput* clouds = nullptr;  ///< stopped; null: no cloud or map output
 };
 
 /// Prints it to stdout; false when there was no pose at all (the estimator never aligned).

@@ -147,6 +147,7 @@ struct MapExport {
 struct MatchedScan {
   std::uint64_t index = 0;  ///< counts matched scans from 1: a new value is a new scan [1]
   HostTime stamp;           ///< the scan's end, where the points are deskewed to
+  HostTime start_stamp;     ///< the scan's first firing (ScanPoint::offset_ns counts from it)
   Eigen::Isometry3d T_map_lidar = Eigen::Isometry3d::Identity();
   std::span<const lidar::ScanPoint> points_lidar;  ///< in the lidar frame at `stamp`
 };
@@ -172,6 +173,9 @@ class FusionCore {
   /// Appends the map and keyframe poses built so far; cores without a map (IMU-only) add
   /// nothing, and so does a core not asked to keep one (LioConfig::keep_map).
   virtual void export_map(MapExport& out) const { (void)out; }
+  /// Replaces `points_map_m` with the local map the scans are matched against (map frame [m]);
+  /// empty for a core without one.
+  virtual void local_map(std::vector<Eigen::Vector3f>& points_map_m) const { points_map_m.clear(); }
   /// The newest matched scan; false for a core without a lidar or before its first match.
   virtual bool latest_matched_scan(MatchedScan& out) const {
     (void)out;

@@ -422,6 +422,7 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     const Eigen::Isometry3d T_map_lidar = pose_of(estimate) * config_.T_imu_lidar;
     matched_[0] = matched_[1];
     matched_[1] = {t, T_map_lidar};
+    matched_start_ = scan.start_stamp;
     ++matched_scans_;
     if (lidar_.commit(T_map_lidar) && config_.keep_map) {
       map_cloud_.add(lidar_.deskewed(), T_map_lidar);
@@ -594,9 +595,15 @@ bool LioEstimator::latest_matched_scan(MatchedScan& out) const {
   if (matched_scans_ == 0 || !matched_[1]) return false;
   out.index = matched_scans_;
   out.stamp = matched_[1]->first;
+  out.start_stamp = matched_start_;
   out.T_map_lidar = matched_[1]->second;
   out.points_lidar = lidar_.deskewed();
   return true;
+}
+
+void LioEstimator::local_map(std::vector<Eigen::Vector3f>& points_map_m) const {
+  points_map_m.clear();
+  lidar_.map_points(points_map_m);
 }
 
 void LioEstimator::export_map(MapExport& out) const {

@@ -116,6 +116,7 @@ class LioEstimator final : public FusionCore {
   FusionFigures figures() const override;
   void export_map(MapExport& out) const override;
   bool latest_matched_scan(MatchedScan& out) const override;
+  void local_map(std::vector<Eigen::Vector3f>& points_map_m) const override;
 
   const lidar::LidarOdometry& lidar_odometry() const { return lidar_; }
   const SlidingWindow& window() const { return window_; }
@@ -184,6 +185,7 @@ class LioEstimator final : public FusionCore {
   bool first_state_emitted_ = false;
   /// the last two matched lidar poses (stamp, T_map_lidar), oldest first
   std::array<std::optional<std::pair<HostTime, Eigen::Isometry3d>>, 2> matched_;
+  HostTime matched_start_;  ///< start stamp of the scan in matched_[1]
   EstimatorMode mode_ = EstimatorMode::kAligning;
   FusionFigures figures_;
   std::uint64_t sequence_ = 0;

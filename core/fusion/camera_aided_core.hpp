@@ -31,6 +31,9 @@ class CameraAidedCore final : public FusionCore, private FrontendObserver {
   std::string_view description() const override { return description_; }
   FusionFigures figures() const override;
   void export_map(MapExport& out) const override { inner_->export_map(out); }
+  void local_map(std::vector<Eigen::Vector3f>& points_map_m) const override {
+    inner_->local_map(points_map_m);
+  }
   bool latest_matched_scan(MatchedScan& out) const override {
     return inner_->latest_matched_scan(out);
   }

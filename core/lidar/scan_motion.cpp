@@ -50,6 +50,7 @@ void deskew(std::span<const LidarPoint> points, HostTime scan_start, const ScanM
     sp.range_m = range;
     sp.intensity = lp.intensity;
     sp.ring = lp.ring;
+    sp.offset_ns = lp.offset_ns;
     // Azimuth of the firing, counter-clockwise from x (the ROS frame), into [0, columns).
     float azimuth = std::atan2(raw.y(), raw.x());
     if (azimuth < 0) azimuth += 2.0f * std::numbers::pi_v<float>;

@@ -37,6 +37,8 @@ struct ScanPoint {
   float intensity = 0;       ///< calibrated reflectivity [0..255]
   std::uint16_t ring = 0;    ///< beam index by elevation, 0 = lowest
   std::uint16_t column = 0;  ///< azimuth bin of the firing (range image column)
+  /// time of the firing relative to the scan's start stamp [ns] (LidarPoint::offset_ns)
+  std::int32_t offset_ns = 0;
 };
 
 /// Moves every point of `points` (offsets from `scan_start`) into the lidar frame at the scan's

@@ -77,6 +77,17 @@ const Field kSchema[] = {
     F("publish.diagnostics", publish.diagnostics, "true", "", 0, 0, "",
       "rt/diagnostics (diagnostic_msgs/DiagnosticArray) with each status: one per stream and "
       "one for the estimator"),
+    F("publish.cloud", publish.cloud, "true", "", 0, 0, "",
+      "rt/posed/cloud (sensor_msgs/PointCloud2): each matched scan deskewed to its end, in the "
+      "lidar frame, fields x y z intensity ring time as the ROS 2 Velodyne driver names them; "
+      "built off the fusion thread's path and only while someone reads it"),
+    F("publish.cloud_max_rate_hz", publish.cloud_max_rate_hz, "0", "Hz", 0, 100, "",
+      "at most this many rt/posed/cloud messages per second; 0: every matched scan"),
+    F("publish.map", publish.map, "true", "", 0, 0, "",
+      "rt/posed/map (sensor_msgs/PointCloud2, transient-local): the local map scans are "
+      "matched against, in the map frame"),
+    F("publish.map_rate_hz", publish.map_rate_hz, "0.2", "Hz", 0.01, 10, "",
+      "rt/posed/map messages per second"),
 
     F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial|can",
       "where IMU samples come from: the synthetic circle, the A9 over serial, or an IMU on a "

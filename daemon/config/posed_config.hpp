@@ -58,6 +58,10 @@ struct PublishSection {
   double path_min_step_m = 0.1;  ///< a pose joins the path after the base moved this far [m]
   int path_max_poses = 10000;    ///< past this, every other old pose is dropped [count]
   bool diagnostics = true;       ///< rt/diagnostics, with each status
+  bool cloud = true;             ///< rt/posed/cloud: each matched scan, deskewed
+  double cloud_max_rate_hz = 0;  ///< at most this many clouds per second; 0: every scan [Hz]
+  bool map = true;               ///< rt/posed/map: the local map, transient-local
+  double map_rate_hz = 0.2;      ///< rt/posed/map messages per second [Hz]
 };
 
 struct ImuSection {

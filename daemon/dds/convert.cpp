@@ -208,6 +208,49 @@ void fill_diagnostics(const DiagnosticsMessage& msg, diagnostic_msgs_msg_dds__Di
   out.status._release = false;
 }
 
+void fill_cloud(const CloudMessage& msg, sensor_msgs_msg_dds__PointCloud2_& out,
+                std::vector<sensor_msgs_msg_dds__PointField_>& fields) {
+  if (fields.size() < msg.fields.size()) fields.resize(msg.fields.size());
+  for (std::size_t i = 0; i < msg.fields.size(); ++i) {
+    const PointFieldMessage& f = msg.fields[i];
+    fields[i].name = c_str(f.name);
+    fields[i].offset = f.offset;
+    fields[i].datatype = f.datatype;
+    fields[i].count = f.count;
+  }
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.header.frame_id = c_str(msg.frame_id);
+  out.height = 1;
+  out.width = msg.width;
+  out.fields._buffer = fields.data();
+  out.fields._length = static_cast<std::uint32_t>(msg.fields.size());
+  out.fields._maximum = static_cast<std::uint32_t>(fields.size());
+  out.fields._release = false;  // the buffers belong to the caller, not to Cyclone
+  out.is_bigendian = false;
+  out.point_step = msg.point_step;
+  out.row_step = msg.point_step * msg.width;
+  out.data._buffer = const_cast<std::uint8_t*>(msg.data.data());
+  out.data._length = static_cast<std::uint32_t>(msg.data.size());
+  out.data._maximum = static_cast<std::uint32_t>(msg.data.size());
+  out.data._release = false;
+  out.is_dense = msg.is_dense;
+}
+
+CloudMessage to_plain(const sensor_msgs_msg_dds__PointCloud2_& in) {
+  CloudMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  msg.frame_id = to_string(in.header.frame_id);
+  for (std::uint32_t i = 0; i < in.fields._length; ++i) {
+    const sensor_msgs_msg_dds__PointField_& f = in.fields._buffer[i];
+    msg.fields.push_back({to_string(f.name), f.offset, f.datatype, f.count});
+  }
+  msg.point_step = in.point_step;
+  msg.width = in.width * std::max<std::uint32_t>(in.height, 1);
+  msg.data.assign(in.data._buffer, in.data._buffer + in.data._length);
+  msg.is_dense = in.is_dense;
+  return msg;
+}
+
 PathMessage to_plain(const nav_msgs_msg_dds__Path_& in) {
   PathMessage msg;
   msg.stamp = from_ros_time(in.header.stamp);

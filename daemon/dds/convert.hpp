@@ -39,12 +39,20 @@ void fill_diagnostics(const DiagnosticsMessage& msg, diagnostic_msgs_msg_dds__Di
                       std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_>& statuses,
                       std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>>& values);
 
+/// Points out's fields at `fields` (grown as needed) and its strings and data into `msg` (valid
+/// while msg lives, unchanged): a cloud is never copied on its way to Cyclone.
+void fill_cloud(const CloudMessage& msg, sensor_msgs_msg_dds__PointCloud2_& out,
+                std::vector<sensor_msgs_msg_dds__PointField_>& fields);
+
 OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in);
 PoseMessage to_plain(const geometry_msgs_msg_dds__PoseStamped_& in);
 StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in);
 TfMessage to_plain(const tf2_msgs_msg_dds__TFMessage_& in);
 PathMessage to_plain(const nav_msgs_msg_dds__Path_& in);
 DiagnosticsMessage to_plain(const diagnostic_msgs_msg_dds__DiagnosticArray_& in);
+/// Copies the data bytes; a big-endian or organised (height > 1) cloud keeps its bytes as sent
+/// with width = all points.
+CloudMessage to_plain(const sensor_msgs_msg_dds__PointCloud2_& in);
 
 /// A C string field as std::string (Cyclone leaves unset strings null).
 std::string to_string(const char* text);

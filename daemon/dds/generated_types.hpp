@@ -7,5 +7,6 @@
 #include "geometry_msgs.h"
 #include "nav_msgs.h"
 #include "posed_msgs.h"
+#include "sensor_msgs.h"
 #include "std_msgs.h"
 #include "tf2_msgs.h"

@@ -17,10 +17,10 @@
 namespace posed::dds {
 
 /// The topics posed publishes.
-enum class Topic { kOdom, kPose, kStatus, kTf, kTfStatic, kPath, kDiagnostics };
-inline constexpr std::array kAllTopics = {Topic::kOdom,       Topic::kPose,     Topic::kStatus,
-                                          Topic::kTf,         Topic::kTfStatic, Topic::kPath,
-                                          Topic::kDiagnostics};
+enum class Topic { kOdom, kPose, kStatus, kTf, kTfStatic, kPath, kDiagnostics, kCloud, kMap };
+inline constexpr std::array kAllTopics = {Topic::kOdom,        Topic::kPose,     Topic::kStatus,
+                                          Topic::kTf,          Topic::kTfStatic, Topic::kPath,
+                                          Topic::kDiagnostics, Topic::kCloud,    Topic::kMap};
 
 /// DDS topic names: ROS 2 prefixes topics with "rt/", so ROS sees /posed/odom, /tf etc.
 inline constexpr std::string_view kOdomTopic = "rt/posed/odom";
@@ -30,6 +30,8 @@ inline constexpr std::string_view kTfTopic = "rt/tf";
 inline constexpr std::string_view kTfStaticTopic = "rt/tf_static";
 inline constexpr std::string_view kPathTopic = "rt/posed/path";
 inline constexpr std::string_view kDiagnosticsTopic = "rt/diagnostics";
+inline constexpr std::string_view kCloudTopic = "rt/posed/cloud";
+inline constexpr std::string_view kMapTopic = "rt/posed/map";
 
 /// The DDS topic name of `topic`, e.g. "rt/posed/odom".
 constexpr std::string_view topic_name(Topic topic) {
@@ -48,9 +50,39 @@ constexpr std::string_view topic_name(Topic topic) {
       return kPathTopic;
     case Topic::kDiagnostics:
       return kDiagnosticsTopic;
+    case Topic::kCloud:
+      return kCloudTopic;
+    case Topic::kMap:
+      return kMapTopic;
   }
   return {};
 }
+
+/// The ROS 2 type `topic` carries, e.g. "nav_msgs/msg/Odometry" (the ros2msg schema name).
+constexpr std::string_view ros_type_name(Topic topic) {
+  switch (topic) {
+    case Topic::kOdom:
+      return "nav_msgs/msg/Odometry";
+    case Topic::kPose:
+      return "geometry_msgs/msg/PoseStamped";
+    case Topic::kStatus:
+      return "posed_msgs/msg/Status";
+    case Topic::kTf:
+    case Topic::kTfStatic:
+      return "tf2_msgs/msg/TFMessage";
+    case Topic::kPath:
+      return "nav_msgs/msg/Path";
+    case Topic::kDiagnostics:
+      return "diagnostic_msgs/msg/DiagnosticArray";
+    case Topic::kCloud:
+    case Topic::kMap:
+      return "sensor_msgs/msg/PointCloud2";
+  }
+  return {};
+}
+
+/// The ROS 2 name of `topic` ("/posed/odom", "/tf"): the DDS name without ROS's "rt" prefix.
+constexpr std::string_view ros_topic_name(Topic topic) { return topic_name(topic).substr(2); }
 
 /// Accepts the DDS name ("rt/posed/odom", "rt/tf"), the ROS name ("/posed/odom", "/tf") or the
 /// last part ("odom", "tf_static").
@@ -134,6 +166,39 @@ struct DiagnosticStatusMessage {
 struct DiagnosticsMessage {
   WallTime stamp;
   std::vector<DiagnosticStatusMessage> status;
+};
+
+/// sensor_msgs/PointField: one field of every point in a CloudMessage.
+struct PointFieldMessage {
+  /// PointField's datatype constants
+  enum Type : std::uint8_t {
+    kInt8 = 1,
+    kUint8 = 2,
+    kInt16 = 3,
+    kUint16 = 4,
+    kInt32 = 5,
+    kUint32 = 6,
+    kFloat32 = 7,
+    kFloat64 = 8
+  };
+  std::string name;          ///< e.g. "x", "intensity", "ring"
+  std::uint32_t offset = 0;  ///< from the start of the point [B]
+  std::uint8_t datatype = kFloat32;
+  std::uint32_t count = 1;  ///< elements [1]
+};
+
+/// sensor_msgs/PointCloud2, unordered (height 1), little-endian: rt/posed/cloud, rt/posed/map.
+struct CloudMessage {
+  /// time the points refer to (wall clock, UNIX epoch) [ns]
+  WallTime stamp;
+  std::string frame_id;
+  std::vector<PointFieldMessage> fields;
+  std::uint32_t point_step = 0;  ///< bytes per point [B]
+  std::uint32_t width = 0;       ///< points [1]
+  /// width * point_step bytes
+  std::vector<std::uint8_t> data;
+  /// no point has a non-finite coordinate
+  bool is_dense = true;
 };
 
 /// posed_msgs/StreamStatus: health of one input stream.
@@ -282,6 +347,10 @@ struct DdsConfig {
   bool path = true;
   /// create a writer for rt/diagnostics (publish.diagnostics)
   bool diagnostics = true;
+  /// create a writer for rt/posed/cloud (publish.cloud)
+  bool cloud = true;
+  /// create a writer for rt/posed/map (publish.map)
+  bool map = true;
   /// DDS Security; empty files: none
   DdsSecurityFiles security;
 };

@@ -85,6 +85,8 @@ void release_domain(std::uint32_t domain_id) {
   }
 }
 
+}  // namespace
+
 const dds_topic_descriptor_t& descriptor(Topic topic) {
   switch (topic) {
     case Topic::kOdom:
@@ -100,9 +102,14 @@ const dds_topic_descriptor_t& descriptor(Topic topic) {
       return nav_msgs_msg_dds__Path__desc;
     case Topic::kDiagnostics:
       return diagnostic_msgs_msg_dds__DiagnosticArray__desc;
+    case Topic::kCloud:
+    case Topic::kMap:
+      return sensor_msgs_msg_dds__PointCloud2__desc;
   }
   return nav_msgs_msg_dds__Odometry__desc;
 }
+
+namespace {
 
 /// The participant QoS that turns on Cyclone's builtin DDS Security plugins (authentication,
 /// access control, cryptography; Debian's libddsc0debian ships them and libddsc finds them by
@@ -186,11 +193,17 @@ dds_qos_t* make_topic_qos(Topic topic) {
   // A reliable writer whose readers' buffers are full waits at most this long in dds_write,
   // so a stalled subscriber costs the publishing thread a bounded time, never a hang.
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(10));
-  if (topic == Topic::kTfStatic) {
+  if (topic == Topic::kTfStatic || topic == Topic::kMap) {
     // tf2_ros::StaticBroadcasterQoS: transient-local, and the one latest message holds every
-    // static transform (a static broadcaster resends them all when one changes).
+    // static transform (a static broadcaster resends them all when one changes). The map is
+    // published as map servers do: the latest one reaches a reader that joins later.
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  } else if (topic == Topic::kCloud) {
+    // A scan is ~0.7 MB: two held per reader bound the memory a slow reader costs; an older
+    // scan is worth nothing once a newer one exists.
+    dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 2);
   } else {
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);

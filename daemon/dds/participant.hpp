@@ -37,6 +37,9 @@ class Participant {
 /// late joiner gets the transforms. Caller deletes with dds_delete_qos.
 dds_qos_t* make_topic_qos(Topic topic);
 
+/// The idlc type descriptor of what `topic` carries (its name, size and serialisation ops).
+const dds_topic_descriptor_t& descriptor(Topic topic);
+
 /// Creates the topic `topic` of the type its descriptor names; error names the topic.
 dds_entity_t create_topic(dds_entity_t participant, Topic topic, std::string& error);
 

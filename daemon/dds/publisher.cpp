@@ -4,10 +4,20 @@
 #include <atomic>
 #include <vector>
 
+#include "daemon/dds/cdr.hpp"
 #include "daemon/dds/convert.hpp"
+#include "daemon/dds/message_tap.hpp"
 #include "daemon/dds/participant.hpp"
 
 namespace posed::dds {
+namespace {
+
+/// A TFMessage has no header of its own: its first transform's stamp stands for it.
+WallTime first_stamp(const TfMessage& msg) {
+  return msg.transforms.empty() ? WallTime{} : msg.transforms.front().stamp;
+}
+
+}  // namespace
 
 struct Publisher::Impl {
   std::unique_ptr<detail::Participant> participant;
@@ -29,16 +39,29 @@ struct Publisher::Impl {
   diagnostic_msgs_msg_dds__DiagnosticArray_ diagnostics_sample{};
   std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> diagnostics_statuses;
   std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> diagnostics_values;
+  sensor_msgs_msg_dds__PointCloud2_ cloud_sample{};
+  std::vector<sensor_msgs_msg_dds__PointField_> cloud_fields;
+  sensor_msgs_msg_dds__PointCloud2_ map_sample{};
+  std::vector<sensor_msgs_msg_dds__PointField_> map_fields;
   std::atomic<std::uint64_t> write_failures{0};
+  MessageTap* tap = nullptr;
+  /// per topic: the last message as CDR, for the tap (its capacity is reused)
+  std::array<std::vector<std::byte>, kAllTopics.size()> cdr;
 
   dds_entity_t& writer(Topic topic) { return writers[static_cast<std::size_t>(topic)]; }
 
-  /// false (nothing sent) for a topic without a writer or a write Cyclone rejected.
-  bool write(Topic topic, const void* sample) {
+  /// false (nothing sent) for a topic without a writer or a write Cyclone rejected. The tap
+  /// gets the message after the DDS write, so it never delays a DDS reader.
+  bool write(Topic topic, const void* sample, WallTime stamp) {
     if (writer(topic) == 0) return false;
-    if (dds_write(writer(topic), sample) == DDS_RETCODE_OK) return true;
-    write_failures.fetch_add(1, std::memory_order_relaxed);
-    return false;
+    const bool ok = dds_write(writer(topic), sample) == DDS_RETCODE_OK;
+    if (!ok) write_failures.fetch_add(1, std::memory_order_relaxed);
+    if (tap != nullptr && tap->wants(topic)) {
+      std::vector<std::byte>& bytes = cdr[static_cast<std::size_t>(topic)];
+      detail::encode_cdr(topic, sample, bytes);
+      tap->deliver(topic, stamp, bytes);
+    }
+    return ok;
   }
 };
 
@@ -61,11 +84,12 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
     }
     return true;
   };
-  const bool ok = make_writer(Topic::kOdom) && make_writer(Topic::kPose) &&
-                  make_writer(Topic::kStatus) &&
-                  (!config.tf || (make_writer(Topic::kTf) && make_writer(Topic::kTfStatic))) &&
-                  (!config.path || make_writer(Topic::kPath)) &&
-                  (!config.diagnostics || make_writer(Topic::kDiagnostics));
+  const bool ok =
+      make_writer(Topic::kOdom) && make_writer(Topic::kPose) && make_writer(Topic::kStatus) &&
+      (!config.tf || (make_writer(Topic::kTf) && make_writer(Topic::kTfStatic))) &&
+      (!config.path || make_writer(Topic::kPath)) &&
+      (!config.diagnostics || make_writer(Topic::kDiagnostics)) &&
+      (!config.cloud || make_writer(Topic::kCloud)) && (!config.map || make_writer(Topic::kMap));
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
 
   impl->map_frame = config.map_frame;
@@ -85,38 +109,59 @@ Publisher::~Publisher() = default;
 
 bool Publisher::publish_odom(const OdomMessage& msg) {
   detail::fill_odom(msg, impl_->odom_sample);
-  return impl_->write(Topic::kOdom, &impl_->odom_sample);
+  return impl_->write(Topic::kOdom, &impl_->odom_sample, msg.stamp);
 }
 
 bool Publisher::publish_pose(const PoseMessage& msg) {
   detail::fill_pose(msg, impl_->pose_sample);
-  return impl_->write(Topic::kPose, &impl_->pose_sample);
+  return impl_->write(Topic::kPose, &impl_->pose_sample, msg.stamp);
 }
 
 bool Publisher::publish_status(const StatusMessage& msg) {
   detail::fill_status(msg, impl_->status_sample, impl_->status_streams);
-  return impl_->write(Topic::kStatus, &impl_->status_sample);
+  return impl_->write(Topic::kStatus, &impl_->status_sample, msg.stamp);
 }
 
 bool Publisher::publish_tf(const TfMessage& msg) {
   detail::fill_tf(msg, impl_->tf_sample, impl_->tf_transforms);
-  return impl_->write(Topic::kTf, &impl_->tf_sample);
+  return impl_->write(Topic::kTf, &impl_->tf_sample, first_stamp(msg));
 }
 
 bool Publisher::publish_tf_static(const TfMessage& msg) {
   detail::fill_tf(msg, impl_->tf_static_sample, impl_->tf_static_transforms);
-  return impl_->write(Topic::kTfStatic, &impl_->tf_static_sample);
+  return impl_->write(Topic::kTfStatic, &impl_->tf_static_sample, first_stamp(msg));
 }
 
 bool Publisher::publish_path(const PathMessage& msg) {
   detail::fill_path(msg, impl_->map_frame.data(), impl_->path_sample, impl_->path_poses);
-  return impl_->write(Topic::kPath, &impl_->path_sample);
+  return impl_->write(Topic::kPath, &impl_->path_sample, msg.stamp);
 }
 
 bool Publisher::publish_diagnostics(const DiagnosticsMessage& msg) {
   detail::fill_diagnostics(msg, impl_->diagnostics_sample, impl_->diagnostics_statuses,
                            impl_->diagnostics_values);
-  return impl_->write(Topic::kDiagnostics, &impl_->diagnostics_sample);
+  return impl_->write(Topic::kDiagnostics, &impl_->diagnostics_sample, msg.stamp);
+}
+
+bool Publisher::publish_cloud(const CloudMessage& msg) {
+  detail::fill_cloud(msg, impl_->cloud_sample, impl_->cloud_fields);
+  return impl_->write(Topic::kCloud, &impl_->cloud_sample, msg.stamp);
+}
+
+bool Publisher::publish_map(const CloudMessage& msg) {
+  detail::fill_cloud(msg, impl_->map_sample, impl_->map_fields);
+  return impl_->write(Topic::kMap, &impl_->map_sample, msg.stamp);
+}
+
+void Publisher::set_tap(MessageTap* tap) { impl_->tap = tap; }
+
+bool Publisher::wanted(Topic topic) const {
+  if (!has_writer(topic)) return false;
+  return matched_subscribers(topic) > 0 || (impl_->tap != nullptr && impl_->tap->wants(topic));
+}
+
+bool Publisher::has_writer(Topic topic) const {
+  return impl_->writers[static_cast<std::size_t>(topic)] != 0;
 }
 
 std::uint32_t Publisher::matched_subscribers(Topic topic) const {

@@ -2,7 +2,8 @@
 // posed's DDS output (DESIGN.md, DDS interface): nav_msgs/Odometry on rt/posed/odom,
 // geometry_msgs/PoseStamped on rt/posed/pose, posed_msgs/Status on rt/posed/status and
 // tf2_msgs/TFMessage on rt/tf and rt/tf_static, nav_msgs/Path on rt/posed/path and
-// diagnostic_msgs/DiagnosticArray on rt/diagnostics, with
+// diagnostic_msgs/DiagnosticArray on rt/diagnostics, sensor_msgs/PointCloud2 on rt/posed/cloud
+// and rt/posed/map, with
 // ROS 2's DDS type names, so `ros2 topic echo /posed/odom` or any plain DDS reader receives them.
 
 #include <cstdint>
@@ -12,6 +13,8 @@
 #include "daemon/dds/messages.hpp"
 
 namespace posed::dds {
+
+class MessageTap;
 
 /// One DDS participant with a writer per topic. Publishing reuses preallocated samples (frame
 /// ids fixed at creation), so it allocates nothing beyond what Cyclone does per write.
@@ -39,6 +42,19 @@ class Publisher {
   /// rt/diagnostics (false, nothing sent, when created without DdsConfig::diagnostics).
   bool publish_diagnostics(const DiagnosticsMessage& msg);
 
+  /// rt/posed/cloud: one deskewed scan (false, nothing sent, without DdsConfig::cloud).
+  bool publish_cloud(const CloudMessage& msg);
+  /// rt/posed/map, transient-local (false, nothing sent, without DdsConfig::map).
+  bool publish_map(const CloudMessage& msg);
+
+  /// Hands every message written from now on to `tap` too, as ROS 2 CDR (MessageTap). Set it
+  /// before the first publish_*; it must outlive the Publisher's writes. nullptr: none.
+  void set_tap(MessageTap* tap);
+  /// Whether a message on `topic` would reach anyone now: a matched DDS reader or the tap. Lets
+  /// the caller skip building a costly message (a cloud) nobody reads.
+  bool wanted(Topic topic) const;
+  /// Whether the config gave `topic` a writer.
+  bool has_writer(Topic topic) const;
   /// Readers currently matched on `topic` [count]; samples before a match are not delivered
   /// (volatile durability), so tests and benchmarks wait for this first.
   std::uint32_t matched_subscribers(Topic topic) const;

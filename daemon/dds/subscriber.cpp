@@ -141,6 +141,14 @@ std::size_t Subscriber::take_diagnostics(std::vector<Received<DiagnosticsMessage
       });
 }
 
+std::size_t Subscriber::take_cloud(Topic topic, std::vector<Received<CloudMessage>>& out) {
+  if (topic != Topic::kCloud && topic != Topic::kMap) return 0;
+  return impl_->take<sensor_msgs_msg_dds__PointCloud2_>(
+      topic, out, [](const sensor_msgs_msg_dds__PointCloud2_& s, Received<CloudMessage>& r) {
+        r.frame_id = detail::to_string(s.header.frame_id);
+      });
+}
+
 std::uint32_t Subscriber::matched_publishers(Topic topic) const {
   const dds_entity_t reader = impl_->reader(topic);
   if (reader == 0) return 0;

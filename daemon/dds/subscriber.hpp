@@ -51,6 +51,8 @@ class Subscriber {
   std::size_t take_tf(Topic topic, std::vector<Received<TfMessage>>& out);
   std::size_t take_path(std::vector<Received<PathMessage>>& out);
   std::size_t take_diagnostics(std::vector<Received<DiagnosticsMessage>>& out);
+  /// rt/posed/cloud or rt/posed/map (`topic`).
+  std::size_t take_cloud(Topic topic, std::vector<Received<CloudMessage>>& out);
 
   /// Writers currently matched on `topic` [count].
   std::uint32_t matched_publishers(Topic topic) const;

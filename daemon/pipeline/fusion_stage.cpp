@@ -50,7 +50,8 @@ class FusionStage::Lane {
 FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<FusionCore> core,
                          FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
                          Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
-                         FusionCounters& counters, OdometryHandover odometry)
+                         FusionCounters& counters, OdometryHandover odometry,
+                         ScanObserver* scan_observer)
     : config_(config),
       core_(std::move(core)),
       inputs_(inputs),
@@ -60,7 +61,8 @@ FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<Fusi
       publisher_(publisher),
       heartbeat_(heartbeat),
       counters_(counters),
-      odometry_(odometry) {
+      odometry_(odometry),
+      scan_observer_(scan_observer) {
   // A scan can release a burst of states (the IMU samples it waited for); no allocation later.
   produced_.reserve(4096);
   outgoing_.reserve(4096);
@@ -155,6 +157,7 @@ void FusionStage::run() {
           newest_received_ = std::max(newest_received_, item.received);
           core_->add_scan(std::move(item.scan), produced_);
           counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);
+          if (scan_observer_ != nullptr) scan_observer_->after_scan(*core_);
           break;
         }
         case Next::kVisible: {

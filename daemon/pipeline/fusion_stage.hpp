@@ -23,6 +23,7 @@
 #include "core/spsc_queue.hpp"
 #include "daemon/config/posed_config.hpp"
 #include "daemon/pipeline/odometry_path.hpp"
+#include "daemon/pipeline/scan_observer.hpp"
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 
@@ -72,7 +73,8 @@ class FusionStage {
   FusionStage(const config::PosedConfig& config, std::unique_ptr<FusionCore> core,
               FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
               Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
-              FusionCounters& counters, OdometryHandover odometry = {});
+              FusionCounters& counters, OdometryHandover odometry = {},
+              ScanObserver* scan_observer = nullptr);
   /// Runs until every input stream has ended, then forwards end-of-stream to the publisher.
   void run();
   const FusionCore& core() const { return *core_; }
@@ -96,6 +98,7 @@ class FusionStage {
   Heartbeat& heartbeat_;
   FusionCounters& counters_;
   OdometryHandover odometry_;
+  ScanObserver* scan_observer_;
   std::vector<NavState> produced_;
   /// states for the publisher, routed from produced_
   std::vector<NavState> outgoing_;

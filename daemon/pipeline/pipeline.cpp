@@ -215,7 +215,7 @@ bool Pipeline::start(std::string& error) {
                                       FusionInputs{&imu_queue_, scan_queue_.get(),
                                                    image_queues_[0].get(), image_queues_[1].get()},
                                       in_stamp_order, state_queue_, fusion_ready_, state_ready_,
-                                      beat, *fusion_counters_, handover);
+                                      beat, *fusion_counters_, handover, outputs_.scan_observer);
     return [this] { fusion_stage_->run(); };
   });
   add_stage("publisher", [&](Heartbeat& beat) {

@@ -26,6 +26,7 @@
 #include "daemon/config/posed_config.hpp"
 #include "daemon/pipeline/odometry_path.hpp"
 #include "daemon/pipeline/pipeline_status.hpp"
+#include "daemon/pipeline/scan_observer.hpp"
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
 #include "drivers/common/source.hpp"
@@ -101,6 +102,9 @@ struct PipelineOutputs {
   std::vector<vision::FrontendMode> frontend_compare_modes;
   /// sees every frame a camera front end processed, on the fusion thread; must outlive the run
   fusion::FrontendObserver* frontend_observer = nullptr;
+  /// looks at the core after every scan, on the fusion thread (rt/posed/cloud and map); must
+  /// outlive the run
+  ScanObserver* scan_observer = nullptr;
 };
 
 /// One stage's last sign of life, for the systemd watchdog.

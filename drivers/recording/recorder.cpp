@@ -52,7 +52,7 @@ bool Recorder::open_file(std::string& error) {
   }
   registered_in_file_ = 0;
   file_has_messages_ = false;
-  pose_schema_ = odom_schema_ = 0;
+  schema_ids_.clear();
   writer_.write_metadata(
       raw::kMetadataName,
       {{std::string(raw::kHostToWallKey), std::to_string(options_.host_to_wall.wall_minus_host.ns)},
@@ -69,21 +69,18 @@ void Recorder::register_channels() {
     const Channel& c = *channels_[registered_in_file_];
     std::uint16_t schema = 0;
     std::string_view encoding = raw::kMessageEncoding;
-    if (c.kind == Kind::kPose) {
-      if (pose_schema_ == 0) {
-        const auto s = ros2::pose_stamped_schema();
-        pose_schema_ = writer_.add_schema(ros2::kPoseStampedName, ros2::kSchemaEncoding,
-                                          {reinterpret_cast<const std::byte*>(s.data()), s.size()});
+    if (!c.schema_name.empty()) {
+      auto it = schema_ids_.find(c.schema_name);
+      if (it == schema_ids_.end()) {
+        const std::string_view s = ros2::schema_for(c.schema_name);
+        it = schema_ids_
+                 .emplace(
+                     c.schema_name,
+                     writer_.add_schema(c.schema_name, ros2::kSchemaEncoding,
+                                        {reinterpret_cast<const std::byte*>(s.data()), s.size()}))
+                 .first;
       }
-      schema = pose_schema_;
-      encoding = ros2::kMessageEncoding;
-    } else if (c.kind == Kind::kOdometry) {
-      if (odom_schema_ == 0) {
-        const auto s = ros2::odometry_schema();
-        odom_schema_ = writer_.add_schema(ros2::kOdometryName, ros2::kSchemaEncoding,
-                                          {reinterpret_cast<const std::byte*>(s.data()), s.size()});
-      }
-      schema = odom_schema_;
+      schema = it->second;
       encoding = ros2::kMessageEncoding;
     }
     // Channel ids are the Recorder's indices in every file, so they match across rotations.
@@ -92,14 +89,16 @@ void Recorder::register_channels() {
 }
 
 std::uint16_t Recorder::add_channel(Kind kind, std::string topic,
-                                    std::map<std::string, std::string> metadata) {
+                                    std::map<std::string, std::string> metadata,
+                                    std::string schema_name, std::size_t queue_capacity) {
   // Called with mutex_ held.
   const std::size_t n = channel_count_.load(std::memory_order_relaxed);
   if (n >= kMaxChannels) return kInvalidChannel;
-  auto c = std::make_unique<Channel>(options_.queue_capacity);
+  auto c = std::make_unique<Channel>(queue_capacity > 0 ? queue_capacity : options_.queue_capacity);
   c->kind = kind;
   c->topic = std::move(topic);
   c->metadata = std::move(metadata);
+  c->schema_name = std::move(schema_name);
   channels_[n] = std::move(c);
   channel_count_.store(n + 1, std::memory_order_release);
   return static_cast<std::uint16_t>(n);
@@ -119,9 +118,26 @@ std::uint16_t Recorder::add_raw_channel(std::string_view stream, std::string_vie
 std::uint16_t Recorder::pose_channel(std::string_view topic, Kind kind) {
   std::lock_guard lock(mutex_);
   if (const auto it = pose_topics_.find(topic); it != pose_topics_.end()) return it->second;
-  const auto id = add_channel(kind, std::string(topic), {});
+  const std::string_view type = kind == Kind::kPose ? ros2::kPoseStampedName : ros2::kOdometryName;
+  const auto id = add_channel(kind, std::string(topic), {}, std::string(type));
   if (id != kInvalidChannel) pose_topics_.emplace(std::string(topic), id);
   return id;
+}
+
+std::uint16_t Recorder::add_ros2_channel(std::string_view topic, std::string_view type_name,
+                                         std::size_t queue_capacity) {
+  if (ros2::schema_for(type_name).empty()) return kInvalidChannel;
+  std::lock_guard lock(mutex_);
+  return add_channel(Kind::kRos2, std::string(topic), {}, std::string(type_name), queue_capacity);
+}
+
+bool Recorder::write_ros2(std::uint16_t channel, WallTime stamp, std::span<const std::byte> cdr) {
+  if (channel >= channel_count_.load(std::memory_order_acquire) ||
+      channels_[channel]->kind != Kind::kRos2) {
+    return false;
+  }
+  return push(channel, stamp.ns - options_.host_to_wall.wall_minus_host.ns,
+              std::vector<std::byte>(cdr.begin(), cdr.end()));
 }
 
 bool Recorder::push(std::uint16_t id, std::int64_t log_time_ns, std::vector<std::byte> bytes) {

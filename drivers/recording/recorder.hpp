@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -102,6 +103,16 @@ class Recorder {
                       const std::array<double, 4>& q_xyzw, const std::array<double, 3>& v_mps,
                       const std::array<double, 3>& w_radps);
 
+  /// A channel of ROS 2 messages of `type_name` (one of ros2_schemas.hpp's, CDR with its ros2msg
+  /// schema) on `topic`, e.g. "/tf": returns its id, or kInvalidChannel when full or the type is
+  /// not one posed knows. `queue_capacity` 0: RecorderOptions::queue_capacity; large messages
+  /// (point clouds) want fewer, so a stalled disk costs bounded memory.
+  std::uint16_t add_ros2_channel(std::string_view topic, std::string_view type_name,
+                                 std::size_t queue_capacity = 0);
+  /// Queues a copy of `cdr` (encapsulation header included) on a channel from
+  /// add_ros2_channel, logged at `stamp` on the host clock. Never blocks; false when dropped.
+  /// One producer per channel, as record().
+  bool write_ros2(std::uint16_t channel, WallTime stamp, std::span<const std::byte> cdr);
   /// Drains every queue, finishes the chunk, writes the summary and closes. Idempotent.
   /// false when a write failed (see error()).
   bool close();
@@ -114,7 +125,7 @@ class Recorder {
   HostToWall host_to_wall() const { return options_.host_to_wall; }
 
  private:
-  enum class Kind : std::uint8_t { kRaw, kPose, kOdometry };
+  enum class Kind : std::uint8_t { kRaw, kPose, kOdometry, kRos2 };
   struct Item {
     std::int64_t log_time_ns = 0;
     /// order of push() across all channels: breaks log-time ties as the producers wrote them
@@ -125,6 +136,8 @@ class Recorder {
     Channel(std::size_t capacity) : queue(capacity, DropPolicy::kDropNewest) {}
     Kind kind = Kind::kRaw;
     std::string topic;
+    /// ROS 2 type of a CDR channel (kPose, kOdometry, kRos2); empty for raw
+    std::string schema_name;
     std::map<std::string, std::string> metadata;
     SpscQueue<Item> queue;
     std::atomic<std::uint64_t> bytes{0};
@@ -132,7 +145,8 @@ class Recorder {
   };
 
   std::uint16_t add_channel(Kind kind, std::string topic,
-                            std::map<std::string, std::string> metadata);
+                            std::map<std::string, std::string> metadata,
+                            std::string schema_name = {}, std::size_t queue_capacity = 0);
   std::uint16_t pose_channel(std::string_view topic, Kind kind);
   bool push(std::uint16_t id, std::int64_t log_time_ns, std::vector<std::byte> bytes);
   void run();
@@ -148,7 +162,8 @@ class Recorder {
   std::size_t registered_in_file_ = 0;  // channels added to the current file
   std::int64_t file_first_log_ns_ = 0;
   bool file_has_messages_ = false;
-  std::uint16_t pose_schema_ = 0, odom_schema_ = 0;
+  /// schema ids in the current file, by ROS 2 type name (writer thread only)
+  std::map<std::string, std::uint16_t, std::less<>> schema_ids_;
 
   std::array<std::unique_ptr<Channel>, kMaxChannels> channels_;
   std::atomic<std::size_t> channel_count_{0};

@@ -5,46 +5,6 @@
 namespace posed::drivers::recording::ros2 {
 namespace {
 
-// The rosbag2 convention for ros2msg schemas: the top-level definition, then each dependency
-// after a line of 80 '=' and "MSG: pkg/Type".
-constexpr std::string_view kSep =
-    "================================================================================\n";
-
-constexpr std::string_view kHeaderDef =
-    "MSG: std_msgs/Header\n"
-    "builtin_interfaces/Time stamp\n"
-    "string frame_id\n";
-constexpr std::string_view kTimeDef =
-    "MSG: builtin_interfaces/Time\n"
-    "int32 sec\n"
-    "uint32 nanosec\n";
-constexpr std::string_view kPoseDef =
-    "MSG: geometry_msgs/Pose\n"
-    "Point position\n"
-    "Quaternion orientation\n";
-constexpr std::string_view kPointDef =
-    "MSG: geometry_msgs/Point\n"
-    "float64 x\n"
-    "float64 y\n"
-    "float64 z\n";
-constexpr std::string_view kQuaternionDef =
-    "MSG: geometry_msgs/Quaternion\n"
-    "float64 x 0\n"
-    "float64 y 0\n"
-    "float64 z 0\n"
-    "float64 w 1\n";
-
-std::string join(std::initializer_list<std::string_view> parts) {
-  std::string s;
-  bool first = true;
-  for (auto p : parts) {
-    if (!first) s += kSep;
-    s += p;
-    first = false;
-  }
-  return s;
-}
-
 /// Appends CDR fields; alignment is relative to the first byte after the encapsulation header.
 class CdrOut {
  public:
@@ -150,40 +110,6 @@ bool read_header_and_pose(CdrIn& in, StampedPose& out, std::string* child) {
 }
 
 }  // namespace
-
-std::string_view pose_stamped_schema() {
-  static const std::string s =
-      join({"# A Pose with reference coordinate frame and timestamp\n"
-            "std_msgs/Header header\n"
-            "Pose pose\n",
-            kHeaderDef, kTimeDef, kPoseDef, kPointDef, kQuaternionDef});
-  return s;
-}
-
-std::string_view odometry_schema() {
-  static const std::string s =
-      join({"# This represents an estimate of a position and velocity in free space.\n"
-            "std_msgs/Header header\n"
-            "string child_frame_id\n"
-            "geometry_msgs/PoseWithCovariance pose\n"
-            "geometry_msgs/TwistWithCovariance twist\n",
-            kHeaderDef, kTimeDef,
-            "MSG: geometry_msgs/PoseWithCovariance\n"
-            "Pose pose\n"
-            "float64[36] covariance\n",
-            kPoseDef, kPointDef, kQuaternionDef,
-            "MSG: geometry_msgs/TwistWithCovariance\n"
-            "Twist twist\n"
-            "float64[36] covariance\n",
-            "MSG: geometry_msgs/Twist\n"
-            "Vector3  linear\n"
-            "Vector3  angular\n",
-            "MSG: geometry_msgs/Vector3\n"
-            "float64 x\n"
-            "float64 y\n"
-            "float64 z\n"});
-  return s;
-}
 
 void encode_pose_stamped(const StampedPose& p, std::vector<std::byte>& out) {
   CdrOut o(out);

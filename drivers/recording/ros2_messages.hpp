@@ -14,17 +14,9 @@
 #include <vector>
 
 #include "core/time.hpp"
+#include "drivers/recording/ros2_schemas.hpp"
 
 namespace posed::drivers::recording::ros2 {
-
-inline constexpr std::string_view kPoseStampedName = "geometry_msgs/msg/PoseStamped";
-inline constexpr std::string_view kOdometryName = "nav_msgs/msg/Odometry";
-inline constexpr std::string_view kSchemaEncoding = "ros2msg";
-inline constexpr std::string_view kMessageEncoding = "cdr";
-
-/// Full ros2msg definition (the type, then each dependency after a `===` line and `MSG: type`).
-std::string_view pose_stamped_schema();
-std::string_view odometry_schema();
 
 /// A pose with its header, as TUM export needs it.
 struct StampedPose {

@@ -227,6 +227,49 @@ void print_path(const dds::Received<dds::PathMessage>& r, bool as_csv) {
               stamp_text(m.stamp).c_str(), r.frame_id.c_str(), m.poses.size(), p.x(), p.y(), p.z());
 }
 
+void print_cloud_header_csv() {
+  std::printf("stamp_s,receive_s,latency_ms,frame_id,points,point_step_B,data_B,fields\n");
+}
+
+/// "x:float32@0 y:float32@4 ..." as PointField describes the layout.
+std::string cloud_fields(const dds::CloudMessage& m) {
+  static const char* kTypes[] = {"?",     "int8",   "uint8",   "int16",  "uint16",
+                                 "int32", "uint32", "float32", "float64"};
+  std::string s;
+  for (const auto& f : m.fields) {
+    if (!s.empty()) s += ' ';
+    s += f.name + ':' + (f.datatype <= 8 ? kTypes[f.datatype] : "?") + '@' +
+         std::to_string(f.offset);
+  }
+  return s;
+}
+
+/// One line per cloud: size, layout and the extent of its x y z (float32 at 0, 4, 8).
+void print_cloud(const dds::Received<dds::CloudMessage>& r, bool as_csv) {
+  const auto& m = r.msg;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  if (as_csv) {
+    std::printf("%s,%s,%.3f,%s,%u,%u,%zu,%s\n", stamp_text(m.stamp).c_str(),
+                stamp_text(r.received_wall).c_str(), lat, csv(r.frame_id).c_str(), m.width,
+                m.point_step, m.data.size(), csv(cloud_fields(m)).c_str());
+    return;
+  }
+  Eigen::Array3f lo = Eigen::Array3f::Constant(0), hi = Eigen::Array3f::Constant(0);
+  const bool xyz = m.point_step >= 12 && m.data.size() >= std::size_t{m.width} * m.point_step;
+  for (std::uint32_t i = 0; xyz && i < m.width; ++i) {
+    Eigen::Array3f p;
+    std::memcpy(p.data(), m.data.data() + std::size_t{i} * m.point_step, 12);
+    lo = i == 0 ? p : lo.min(p);
+    hi = i == 0 ? p : hi.max(p);
+  }
+  std::printf(
+      "cloud %s s in %s  %u points x %u B (%.2f MB)  x [%.1f %.1f] y [%.1f %.1f] z [%.1f %.1f] m"
+      "  fields %s\n",
+      stamp_text(m.stamp).c_str(), r.frame_id.c_str(), m.width, m.point_step,
+      static_cast<double>(m.data.size()) / 1e6, lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z(),
+      cloud_fields(m).c_str());
+}
+
 void print_diagnostics_header_csv() {
   std::printf("stamp_s,receive_s,latency_ms,level,name,message,hardware_id,values\n");
 }
@@ -379,6 +422,7 @@ void write_tum(std::FILE*, const dds::Received<dds::StatusMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::TfMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::PathMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::DiagnosticsMessage>&) {}
+void write_tum(std::FILE*, const dds::Received<dds::CloudMessage>&) {}
 
 /// The stamp a message's latency is measured from (a tf message: its first transform's).
 WallTime stamp_of(const dds::OdomMessage& m) { return m.stamp; }
@@ -386,6 +430,7 @@ WallTime stamp_of(const dds::PoseMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::StatusMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::PathMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::DiagnosticsMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::CloudMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::TfMessage& m) {
   return m.transforms.empty() ? WallTime{} : m.transforms.front().stamp;
 }
@@ -426,9 +471,10 @@ int run_echo(int argc, char** argv) {
   std::string cyclone_config;
   std::string tum_path;
   std::string enclave;
-  app.add_option("topic", topic_arg,
-                 "odom, pose, status, tf, tf_static, or the full DDS name (rt/posed/odom, rt/tf) "
-                 "or ROS name")
+  app.add_option(
+         "topic", topic_arg,
+         "odom, pose, status, tf, tf_static, path, diagnostics, cloud, map, or the full DDS "
+         "name (rt/posed/odom, rt/tf) or ROS name")
       ->capture_default_str();
   app.add_flag("--csv", as_csv,
                "CSV with a header line on stdout; rate/latency reports go to stderr");
@@ -454,8 +500,9 @@ int run_echo(int argc, char** argv) {
   if (!dds::parse_topic(topic_arg, topic)) {
     std::fprintf(stderr,
                  "posectl echo: unknown topic '%s' (expected odom, pose, status, path, tf, "
-                 "tf_static, diagnostics, or their DDS names rt/posed/{odom,pose,status,path}, "
-                 "rt/tf, rt/tf_static, rt/diagnostics)\n",
+                 "tf_static, diagnostics, cloud, map, or their DDS names "
+                 "rt/posed/{odom,pose,status,path,cloud,map}, rt/tf, rt/tf_static, "
+                 "rt/diagnostics)\n",
                  topic_arg.c_str());
     return 2;
   }
@@ -497,6 +544,7 @@ int run_echo(int argc, char** argv) {
     if (topic == dds::Topic::kTf || topic == dds::Topic::kTfStatic) print_tf_header_csv();
     if (topic == dds::Topic::kPath) print_path_header_csv();
     if (topic == dds::Topic::kDiagnostics) print_diagnostics_header_csv();
+    if (topic == dds::Topic::kCloud || topic == dds::Topic::kMap) print_cloud_header_csv();
   }
   std::fprintf(stderr, "posectl echo: listening on %s (domain %u)\n", topic_name.c_str(), domain);
 
@@ -543,6 +591,11 @@ int run_echo(int argc, char** argv) {
       case dds::Topic::kDiagnostics:
         drain<dds::DiagnosticsMessage>([&](auto& v) { subscriber->take_diagnostics(v); },
                                        print_diagnostics, as_csv, nullptr, stats, count);
+        break;
+      case dds::Topic::kCloud:
+      case dds::Topic::kMap:
+        drain<dds::CloudMessage>([&](auto& v) { subscriber->take_cloud(topic, v); }, print_cloud,
+                                 as_csv, nullptr, stats, count);
         break;
     }
   }

@@ -2,6 +2,8 @@
 // against a hand-computed little-endian layout: the wire format must be ROS 2's, since CDR is
 // positional and a ROS 2 reader decodes it without any type negotiation.
 
+#include "daemon/dds/cdr.hpp"
+
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 #include <gtest/gtest.h>
@@ -14,6 +16,7 @@
 #include "daemon/dds/convert.hpp"
 #include "daemon/dds/generated_types.hpp"
 #include "daemon/dds/participant.hpp"
+#include "drivers/recording/ros2_messages.hpp"
 #include "tests/unit/dds/test_domain.hpp"
 
 namespace posed::dds {
@@ -411,6 +414,106 @@ TEST_F(CdrLoop, TfPathAndDiagnosticsRoundTripThroughTheirFillers) {
   EXPECT_EQ(diag_back.status[1].message, "lidar_inertial");
   EXPECT_TRUE(diag_back.status[1].values.empty());
   free_sample(diagnostic_msgs_msg_dds__DiagnosticArray__desc, diag_out);
+}
+
+/// The wire form without what Cyclone adds for the transport: XCDR lets a writer pad the payload
+/// to a multiple of 4 and count the padding in the low bits of the encapsulation options (ROS 2
+/// readers, Foxglove and MCAP take either form).
+std::vector<unsigned char> unpadded(std::vector<unsigned char> bytes) {
+  if (bytes.size() < 4) return bytes;
+  const std::size_t padding = bytes[3] & 3u;
+  bytes.resize(bytes.size() - std::min(padding, bytes.size() - 4));
+  bytes[2] = bytes[3] = 0;
+  return bytes;
+}
+
+TEST_F(CdrLoop, PointCloud2BytesMatchRos2Layout) {
+  CloudMessage cloud;
+  cloud.stamp = WallTime::from_ns(5'000'000'007);
+  cloud.frame_id = "velodyne";
+  cloud.fields = {{"x", 0, PointFieldMessage::kFloat32, 1},
+                  {"ring", 4, PointFieldMessage::kUint16, 1}};
+  cloud.point_step = 6;
+  cloud.width = 2;
+  cloud.data = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  sensor_msgs_msg_dds__PointCloud2_ in{};
+  std::vector<sensor_msgs_msg_dds__PointField_> fields;
+  detail::fill_cloud(cloud, in, fields);
+  sensor_msgs_msg_dds__PointCloud2_ out{};
+  const auto bytes = round_trip(sensor_msgs_msg_dds__PointCloud2__desc, in, out);
+
+  CdrBuilder expected;  // PointCloud2.msg in order; uint8 and bool are one byte, unaligned
+  expected.put<std::int32_t>(5);
+  expected.put<std::uint32_t>(7);
+  expected.put_string("velodyne");
+  expected.put<std::uint32_t>(1);  // height
+  expected.put<std::uint32_t>(2);  // width
+  expected.put<std::uint32_t>(2);  // fields
+  expected.put_string("x");
+  expected.put<std::uint32_t>(0);
+  expected.put<std::uint8_t>(7);
+  expected.put<std::uint32_t>(1);
+  expected.put_string("ring");
+  expected.put<std::uint32_t>(4);
+  expected.put<std::uint8_t>(4);
+  expected.put<std::uint32_t>(1);
+  expected.put<std::uint8_t>(0);    // is_bigendian
+  expected.put<std::uint32_t>(6);   // point_step
+  expected.put<std::uint32_t>(12);  // row_step
+  expected.put<std::uint32_t>(12);  // data
+  for (int i = 1; i <= 12; ++i) expected.put<std::uint8_t>(static_cast<std::uint8_t>(i));
+  expected.put<std::uint8_t>(1);  // is_dense
+  EXPECT_EQ(unpadded(bytes), expected.bytes);
+
+  const CloudMessage back = detail::to_plain(out);
+  EXPECT_EQ(back.stamp, cloud.stamp);
+  EXPECT_EQ(back.frame_id, "velodyne");
+  ASSERT_EQ(back.fields.size(), 2u);
+  EXPECT_EQ(back.fields[1].name, "ring");
+  EXPECT_EQ(back.fields[1].datatype, PointFieldMessage::kUint16);
+  EXPECT_EQ(back.data, cloud.data);
+  free_sample(sensor_msgs_msg_dds__PointCloud2__desc, out);
+}
+
+// What the Publisher hands a MessageTap (Foxglove, the recording) is byte for byte what goes on
+// the DDS wire, and for a PoseStamped also what the recording's hand-written encoder writes.
+TEST_F(CdrLoop, EncodeCdrGivesTheWireBytes) {
+  char frame[] = "map";
+  geometry_msgs_msg_dds__PoseStamped_ in{};
+  in.header.stamp = {1'700'000'001, 5};
+  in.header.frame_id = frame;
+  in.pose.position = {1, 2, 3};
+  in.pose.orientation = {0, 0, 0.6, 0.8};
+  geometry_msgs_msg_dds__PoseStamped_ out{};
+  const auto wire = unpadded(round_trip(geometry_msgs_msg_dds__PoseStamped__desc, in, out));
+  free_sample(geometry_msgs_msg_dds__PoseStamped__desc, out);
+  std::vector<std::byte> tapped;
+  detail::encode_cdr(Topic::kPose, &in, tapped);
+  ASSERT_EQ(tapped.size(), wire.size());
+  EXPECT_EQ(std::memcmp(tapped.data(), wire.data(), wire.size()), 0);
+
+  std::vector<std::byte> recorded;
+  drivers::recording::ros2::encode_pose_stamped(
+      {WallTime::from_ns(1'700'000'001'000'000'005), "map", {1, 2, 3}, {0, 0, 0.6, 0.8}}, recorded);
+  EXPECT_EQ(recorded, tapped);
+
+  // A second, larger message reuses the buffer and is still exact.
+  CloudMessage cloud;
+  cloud.frame_id = "velodyne";
+  cloud.fields = {{"x", 0, PointFieldMessage::kFloat32, 1}};
+  cloud.point_step = 4;
+  cloud.width = 1000;
+  cloud.data.assign(4000, 0xAB);
+  sensor_msgs_msg_dds__PointCloud2_ cloud_in{};
+  std::vector<sensor_msgs_msg_dds__PointField_> fields;
+  detail::fill_cloud(cloud, cloud_in, fields);
+  sensor_msgs_msg_dds__PointCloud2_ cloud_out{};
+  const auto cloud_wire =
+      unpadded(round_trip(sensor_msgs_msg_dds__PointCloud2__desc, cloud_in, cloud_out));
+  free_sample(sensor_msgs_msg_dds__PointCloud2__desc, cloud_out);
+  detail::encode_cdr(Topic::kCloud, &cloud_in, tapped);
+  ASSERT_EQ(tapped.size(), cloud_wire.size());
+  EXPECT_EQ(std::memcmp(tapped.data(), cloud_wire.data(), cloud_wire.size()), 0);
 }
 
 }  // namespace

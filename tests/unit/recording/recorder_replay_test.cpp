@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -304,6 +305,46 @@ TEST(Recorder, PosesAreRos2CdrWithRos2msgSchemas) {
   // the host-to-wall offset is in the "posed" metadata record
   ASSERT_FALSE(r.metadata().empty());
   EXPECT_EQ(r.metadata()[0].entries.at("host_to_wall_ns"), "1700000000000000000");
+}
+
+TEST(Recorder, Ros2ChannelsCarryTheirSchemasInEveryRotatedFile) {
+  test::TempDir dir("rec_ros2");
+  RecorderOptions opt;
+  opt.writer.fsync_on_close = false;
+  opt.rotate_bytes = 1;  // every message closes its file: each later file must register again
+  Recorder rec;
+  std::string error;
+  ASSERT_TRUE(rec.open(dir.file("r.mcap"), opt, error)) << error;
+  EXPECT_EQ(rec.add_ros2_channel("/nope", "not_a/msg/Type"), Recorder::kInvalidChannel);
+  const std::uint16_t tf = rec.add_ros2_channel("/tf", ros2::kTfMessageName);
+  const std::uint16_t cloud = rec.add_ros2_channel("/posed/cloud", ros2::kPointCloud2Name, 2);
+  ASSERT_NE(tf, Recorder::kInvalidChannel);
+  ASSERT_NE(cloud, Recorder::kInvalidChannel);
+  const std::vector<std::byte> body(40, std::byte{7});
+  ASSERT_TRUE(rec.write_ros2(tf, WallTime::from_ns(1000), body));
+  ASSERT_TRUE(rec.write_ros2(cloud, WallTime::from_ns(2000), body));
+  ASSERT_TRUE(rec.write_ros2(tf, WallTime::from_ns(3000), body));
+  EXPECT_FALSE(rec.write_ros2(Recorder::kInvalidChannel, WallTime::from_ns(4000), body));
+  ASSERT_TRUE(rec.close());
+  std::map<std::string, int> seen;
+  for (const std::string& file : rec.files()) {
+    McapReader r;
+    ASSERT_TRUE(r.open(file, error)) << error;
+    McapMessage m;
+    while (r.next(m)) {
+      const McapSchemaRecord* schema = r.schema(m.channel->schema_id);
+      ASSERT_NE(schema, nullptr) << file;
+      EXPECT_EQ(schema->encoding, "ros2msg");
+      EXPECT_EQ(m.channel->message_encoding, "cdr");
+      const std::string text(reinterpret_cast<const char*>(schema->data.data()),
+                             schema->data.size());
+      EXPECT_EQ(text, ros2::schema_for(schema->name));
+      EXPECT_EQ(m.data.size(), body.size());
+      ++seen[m.channel->topic + " " + schema->name];
+    }
+  }
+  EXPECT_EQ(seen["/tf tf2_msgs/msg/TFMessage"], 2);
+  EXPECT_EQ(seen["/posed/cloud sensor_msgs/msg/PointCloud2"], 1);
 }
 
 }  // namespace
