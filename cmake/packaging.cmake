@@ -24,9 +24,9 @@ if(NOT CMAKE_INSTALL_PREFIX STREQUAL "/usr")
 endif()
 include(GNUInstallDirs)
 
-# Debian 12 still ships units and udev rules under /lib (dpkg's file lists predate the /usr
-# merge, and its lintian flags units elsewhere); sysusers.d and tmpfiles.d were always in /usr.
-# systemd/CMakeLists.txt installs to these.
+# Debian 12's packages (systemd's own, and what its debhelper builds) list units and udev rules
+# under /lib: the /usr merge moved the directories, not the paths in dpkg's file lists. sysusers.d
+# and tmpfiles.d were always in /usr. systemd/CMakeLists.txt installs to these.
 set(POSED_SYSTEMD_UNIT_DIR "/lib/systemd/system" CACHE STRING "where posed.service is installed" FORCE)
 set(POSED_UDEV_RULES_DIR "/lib/udev/rules.d" CACHE STRING "where the udev rules are installed" FORCE)
 
