@@ -27,8 +27,8 @@ struct ServerOptions {
   std::string address = "127.0.0.1";  ///< IPv4 or IPv6 literal; loopback unless asked otherwise
   std::uint16_t port = 8765;          ///< 0: an ephemeral port, see Server::port() (tests)
   std::string name = "posed";         ///< serverInfo's name, shown by Foxglove Studio
-  std::size_t max_queued_bytes_per_client =
-      8 << 20;                      ///< beyond this a slow client loses messages [B]
+  /// Queued for one client, beyond which a slow client loses messages [B]
+  std::size_t max_queued_bytes_per_client = 8 << 20;
   std::size_t max_channels = 1024;  ///< add_channel() beyond this throws
 };
 
@@ -58,7 +58,7 @@ struct ServerStats {
 class Server {
  public:
   /// Binds and starts its own I/O thread. On failure returns nullptr and sets `error`, naming
-  /// address:port and the OS's reason ("foxglove server: cannot bind 127.0.0.1:8765: Address
+  /// address:port and the OS's reason ("foxglove server: cannot listen on 127.0.0.1:8765: Address
   /// already in use").
   static std::unique_ptr<Server> start(const ServerOptions& options, std::string& error);
   ~Server();  ///< closes every client's connection and joins the I/O thread
