@@ -28,6 +28,10 @@ struct ChannelSpec {
   std::string schema_name;      ///< e.g. "nav_msgs/msg/Odometry"
   std::string schema_encoding;  ///< "ros2msg"
   std::string schema;           ///< full schema text in schema_encoding
+  /// Keep the newest message and send it to every client that subscribes later, as a
+  /// transient-local DDS topic reaches a late reader (rt/tf_static, rt/posed/map): the
+  /// protocol itself has no such notion, and Foxglove Studio connects whenever its user does.
+  bool latched = false;
 };
 
 /// Assigned by the server, from 1; 0 is never a channel.

@@ -91,6 +91,14 @@ struct alignas(64) ChannelSlot {
   std::atomic<std::uint64_t> sent{0};
   std::atomic<std::uint64_t> dropped{0};
   std::atomic<std::uint64_t> bytes_sent{0};
+  bool latched = false;  ///< set before the channel is published (channel_count's release)
+};
+
+/// A latched channel's newest message, for clients that subscribe later.
+struct LatchedMessage {
+  std::int64_t log_time_ns = 0;
+  Payload payload;
+  bool present = false;
 };
 
 struct Subscriber {
@@ -142,7 +150,11 @@ struct Server::Impl {
   std::vector<ChannelSpec> specs;                    // [id - 1]
   std::vector<std::string> channel_objects;          // [id - 1], channel_json()
   std::vector<std::vector<Subscriber>> subscribers;  // [id - 1]
-  std::vector<std::shared_ptr<Session>> sessions;    // past the handshake
+  /// [id - 1]; written by publish() under the shared registry lock and latch_mutex, read by
+  /// subscribe() under the unique one: a new subscriber gets each message once, never twice.
+  std::vector<LatchedMessage> latched;
+  std::mutex latch_mutex;
+  std::vector<std::shared_ptr<Session>> sessions;  // past the handshake
 
   /// Every connection, handshake or not, so shutdown can close them (I/O thread only).
   std::vector<std::weak_ptr<Session>> connections;
@@ -471,6 +483,16 @@ void Server::Impl::subscribe(const std::shared_ptr<Session>& session,
       session->subscriptions.emplace(wanted.id, wanted.channel);
       subscribers[wanted.channel - 1].push_back({session, wanted.id});
       slots[wanted.channel - 1].subscribers.fetch_add(1, std::memory_order_release);
+      const LatchedMessage& last = latched[wanted.channel - 1];
+      if (last.present) {
+        // Counted as sent once written, as every message is.
+        if (!session->send(
+                OutFrame::message_data(
+                    wanted.channel, message_data_header(wanted.id, last.log_time_ns), last.payload),
+                Admission::kBounded)) {
+          slots[wanted.channel - 1].dropped.fetch_add(1, std::memory_order_relaxed);
+        }
+      }
     }
   }
   for (const std::string& reason : refusals) refuse(*session, reason);
@@ -558,6 +580,8 @@ ChannelId Server::add_channel(const ChannelSpec& spec) {
   impl.specs.push_back(spec);
   impl.channel_objects.push_back(channel_json(id, spec));
   impl.subscribers.emplace_back();
+  impl.latched.emplace_back();
+  impl.slots[id - 1].latched = spec.latched;
   impl.channel_count.store(id, std::memory_order_release);
   const std::string advertise = advertise_json(std::span(&impl.channel_objects.back(), 1));
   for (const auto& session : impl.sessions) {
@@ -571,10 +595,15 @@ void Server::publish(ChannelId channel, std::int64_t log_time_ns,
   ChannelSlot* slot = impl_->slot(channel);
   if (slot == nullptr) return;
   slot->published.fetch_add(1, std::memory_order_relaxed);
-  if (slot->subscribers.load(std::memory_order_acquire) == 0) return;  // the common case: free
+  // The common case, free: nobody subscribes and nothing is kept for later subscribers.
+  if (!slot->latched && slot->subscribers.load(std::memory_order_acquire) == 0) return;
 
   const Payload shared = copy_payload(payload);
   std::shared_lock lock(impl_->registry_mutex);
+  if (slot->latched) {
+    std::lock_guard latch(impl_->latch_mutex);
+    impl_->latched[channel - 1] = {log_time_ns, shared, true};
+  }
   for (const Subscriber& subscriber : impl_->subscribers[channel - 1]) {
     OutFrame frame = OutFrame::message_data(
         channel, message_data_header(subscriber.subscription, log_time_ns), shared);

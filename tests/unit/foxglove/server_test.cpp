@@ -263,6 +263,36 @@ TEST(FoxgloveServer, ManyClientsAtOnceEachGetEveryMessage) {
       [&] { return channel_stats(server->stats(), odom).messages_sent == kClients * kMessages; }));
 }
 
+TEST(FoxgloveServer, LatchedChannelGivesItsNewestMessageToLaterSubscribers) {
+  auto server = start_server();
+  ChannelSpec statics = spec("/tf_static");
+  statics.latched = true;
+  const ChannelId tf_static = server->add_channel(statics);
+  const ChannelId path = server->add_channel(spec("/posed/path"));
+  // Published before anyone connected: the latched channel keeps the newest, the other nothing.
+  server->publish(tf_static, 1, bytes_of("first"));
+  server->publish(tf_static, 2, bytes_of("newest"));
+  server->publish(path, 3, bytes_of("gone"));
+
+  for (int round = 0; round < 2; ++round) {  // every later subscriber, not only the first
+    TestClient client;
+    connect_and_greet(client, *server);
+    ASSERT_TRUE(client.subscribe(4, path));
+    ASSERT_TRUE(client.subscribe(5, tf_static));
+    const auto message = client.next_message_data();
+    ASSERT_TRUE(message.has_value());
+    EXPECT_EQ(message->subscription, 5u);
+    EXPECT_EQ(message->log_time_ns, 2u);
+    EXPECT_EQ(message->payload, "newest");
+    // Live messages follow on both, each once.
+    server->publish(path, 6, bytes_of("live path"));
+    const auto live = client.next_message_data();
+    ASSERT_TRUE(live.has_value());
+    EXPECT_EQ(live->payload, "live path");
+    EXPECT_FALSE(client.next_message_data(200ms).has_value());
+  }
+}
+
 TEST(FoxgloveServer, ClientWithoutTheSubprotocolIsRefusedWithAReason) {
   auto server = start_server();
   server->add_channel(spec("/posed/odom"));
