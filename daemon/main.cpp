@@ -78,7 +78,8 @@ int main(int argc, char** argv) noexcept try {
       ->needs(replay);
   app.add_option("--wait-subscribers", options.wait_subscribers_s,
                  "before publishing, wait up to this long for a reader of rt/posed/odom or "
-                 "rt/posed/pose to match [s]; default 1 with --replay, 0 live")
+                 "rt/posed/pose to match, over DDS or a Foxglove client subscribed to /posed/odom "
+                 "or /posed/pose [s]; default 1 with --replay, 0 live")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--version", version, "print the version and exit");
   CLI11_PARSE(app, argc, argv);

@@ -2,7 +2,9 @@
 
 #include <sstream>
 
+#include "daemon/foxglove/server.hpp"
 #include "drivers/recording/recorder.hpp"
+#include "drivers/recording/ros2_schemas.hpp"
 
 namespace posed {
 
@@ -32,9 +34,22 @@ bool parse_record_outputs(const std::string& text, std::vector<dds::Topic>& topi
 }
 
 OutputTap::OutputTap(drivers::recording::Recorder* recorder,
-                     std::span<const dds::Topic> record_topics)
-    : recorder_(recorder) {
+                     std::span<const dds::Topic> record_topics, foxglove::Server* foxglove,
+                     std::span<const dds::Topic> served_topics)
+    : recorder_(recorder), foxglove_(foxglove) {
   record_channel_.fill(kNone);
+  if (foxglove_ != nullptr) {
+    namespace ros2 = drivers::recording::ros2;
+    for (dds::Topic t : served_topics) {
+      const std::string_view type = dds::ros_type_name(t);
+      // Transient-local on DDS, latched here: Studio connects whenever its user does.
+      const bool latched = t == dds::Topic::kTfStatic || t == dds::Topic::kMap;
+      foxglove_channel_[static_cast<std::size_t>(t)] = foxglove_->add_channel(
+          {std::string(dds::ros_topic_name(t)), std::string(ros2::kMessageEncoding),
+           std::string(type), std::string(ros2::kSchemaEncoding),
+           std::string(ros2::schema_for(type)), latched});
+    }
+  }
   if (recorder_ == nullptr) return;
   for (dds::Topic t : record_topics) {
     if (t == dds::Topic::kOdom || t == dds::Topic::kPose) continue;
@@ -46,7 +61,11 @@ OutputTap::OutputTap(drivers::recording::Recorder* recorder,
 }
 
 bool OutputTap::wants(dds::Topic topic) const {
-  return record_channel_[static_cast<std::size_t>(topic)] != kNone;
+  const auto i = static_cast<std::size_t>(topic);
+  const bool latched = topic == dds::Topic::kTfStatic || topic == dds::Topic::kMap;
+  return record_channel_[i] != kNone ||
+         (foxglove_channel_[i] != 0 &&
+          (latched || foxglove_->has_subscribers(foxglove_channel_[i])));
 }
 
 void OutputTap::deliver(dds::Topic topic, WallTime stamp, std::span<const std::byte> cdr) {
@@ -54,6 +73,8 @@ void OutputTap::deliver(dds::Topic topic, WallTime stamp, std::span<const std::b
   if (record_channel_[i] != kNone && !recorder_->write_ros2(record_channel_[i], stamp, cdr)) {
     ++record_drops_[i];
   }
+  // Foxglove's log time is the message's stamp: its timeline then shows the data's time.
+  if (foxglove_channel_[i] != 0) foxglove_->publish(foxglove_channel_[i], stamp.ns, cdr);
 }
 
 }  // namespace posed

@@ -15,6 +15,7 @@
 #include "daemon/build_info.hpp"
 #include "daemon/cloud_output.hpp"
 #include "daemon/dds/publisher.hpp"
+#include "daemon/foxglove/server.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
 #include "daemon/output_tap.hpp"
@@ -167,7 +168,30 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     POSED_LOG_ERROR("%s", error.c_str());
     return 1;
   }
-  OutputTap output_tap(recorder.get(), record_outputs);
+  // Foxglove Studio live: every topic DDS carries, on the WebSocket server's own thread.
+  std::unique_ptr<foxglove::Server> foxglove_server;
+  std::vector<dds::Topic> served;
+  if (publisher && config.foxglove.enabled) {
+    foxglove::ServerOptions fox;
+    fox.address = config.foxglove.address;
+    fox.port = static_cast<std::uint16_t>(config.foxglove.port);
+    fox.name = std::string(version_string());
+    fox.max_queued_bytes_per_client = static_cast<std::size_t>(config.foxglove.max_queued_mb * 1e6);
+    foxglove_server = foxglove::Server::start(fox, error);
+    if (!foxglove_server) {
+      POSED_LOG_ERROR("%s (foxglove.address, foxglove.port in %s)", error.c_str(),
+                      options.config_path.c_str());
+      return 1;
+    }
+    for (dds::Topic t : dds::kAllTopics) {
+      if (publisher->has_writer(t)) served.push_back(t);
+    }
+    POSED_LOG_INFO("foxglove: serving %zu topics on ws://%s:%u", served.size(),
+                   config.foxglove.address.c_str(), foxglove_server->port());
+  } else if (config.foxglove.enabled) {
+    POSED_LOG_NOTICE("foxglove.enabled, but this run publishes nothing: no Foxglove server");
+  }
+  OutputTap output_tap(recorder.get(), record_outputs, foxglove_server.get(), served);
   if (publisher) publisher->set_tap(&output_tap);
   // Point clouds are built and written off the fusion thread, only with a lidar to make them.
   std::unique_ptr<CloudOutput> cloud_output;
@@ -196,8 +220,10 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
                                                         : 0.0;
   if (publisher && wait_s > 0) {
     const HostTime give_up = drivers::host_now() + Duration::from_seconds(wait_s);
+    // A reader: a DDS reader of odom or pose, or a Foxglove client subscribed to either.
     while (publisher->matched_subscribers(dds::Topic::kOdom) == 0 &&
            publisher->matched_subscribers(dds::Topic::kPose) == 0 &&
+           !output_tap.wants(dds::Topic::kOdom) && !output_tap.wants(dds::Topic::kPose) &&
            drivers::host_now() < give_up) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
@@ -294,7 +320,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
                            map_line,
                            synthetic,
                            publisher != nullptr,
-                           cloud_output.get()};
+                           cloud_output.get(),
+                           foxglove_server.get()};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

@@ -6,6 +6,7 @@
 
 #include "daemon/cloud_output.hpp"
 #include "daemon/estimator_summary.hpp"
+#include "daemon/foxglove/server.hpp"
 #include "daemon/pipeline/pipeline.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/recording/recorder.hpp"
@@ -130,6 +131,24 @@ bool print_run_summary(const RunSummary& r) {
           static_cast<unsigned long long>(c.clouds_replaced),
           static_cast<unsigned long long>(c.maps), static_cast<double>(c.last_map_bytes) / 1e6,
           c.failed ? " (some writes failed)" : "");
+    }
+    if (r.foxglove != nullptr) {
+      const foxglove::ServerStats fs = r.foxglove->stats();
+      std::uint64_t sent = 0, dropped = 0;
+      std::string per_channel;
+      for (const foxglove::ChannelStats& c : fs.channels) {
+        sent += c.messages_sent;
+        dropped += c.messages_dropped;
+        if (c.messages_sent == 0) continue;
+        per_channel +=
+            (per_channel.empty() ? "" : ", ") + c.topic + " " + std::to_string(c.messages_sent);
+      }
+      std::printf(
+          "  foxglove            port %u: %llu clients; %llu messages sent (%s), %llu "
+          "dropped for slow clients, %.1f MB\n",
+          r.foxglove->port(), static_cast<unsigned long long>(fs.clients_accepted),
+          static_cast<unsigned long long>(sent), per_channel.empty() ? "none" : per_channel.c_str(),
+          static_cast<unsigned long long>(dropped), static_cast<double>(fs.bytes_sent) / 1e6);
     }
     const std::string_view mode = r.pipe.odometry_mode();
     std::printf("  odometry            %s\n",

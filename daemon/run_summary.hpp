@@ -23,6 +23,9 @@ class Recorder;
 }
 
 class CloudOutput;
+namespace foxglove {
+class Server;
+}
 
 struct RunSummary {
   const config::PosedConfig& config;
@@ -38,6 +41,7 @@ struct RunSummary {
   const drivers::SyntheticImuSource* synthetic = nullptr;  ///< the truth of a synthetic IMU
   bool published = true;                ///< a DDS participant published (false: an offline run)
   const CloudOutput* clouds = nullptr;  ///< stopped; null: no cloud or map output
+  const foxglove::Server* foxglove = nullptr;  ///< null: no Foxglove server
 };
 
 /// Prints it to stdout; false when there was no pose at all (the estimator never aligned).

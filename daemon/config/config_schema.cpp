@@ -454,6 +454,17 @@ const Field kSchema[] = {
 
     F("watchdog.stage_deadline_s", watchdog.stage_deadline_s, "1", "s", 0.01, 60, "",
       "a stage silent this long stops the systemd watchdog"),
+
+    F("foxglove.enabled", foxglove.enabled, "false", "", 0, 0, "",
+      "serve posed's topics to Foxglove Studio over the Foxglove WebSocket protocol "
+      "(foxglove.websocket.v1, ros2msg schemas, CDR)"),
+    F("foxglove.address", foxglove.address, "127.0.0.1", "", 0, 0, "",
+      "address the Foxglove server listens on: loopback by default; 0.0.0.0 or a robot's "
+      "address to be reached from a laptop (the unit's IPAddressAllow applies)"),
+    F("foxglove.port", foxglove.port, "8765", "", 0, 65535, "",
+      "TCP port of the Foxglove server (Foxglove Studio's default 8765; 0: any free port, logged)"),
+    F("foxglove.max_queued_mb", foxglove.max_queued_mb, "8", "MB", 0.1, 1024, "",
+      "messages queued per client before a slow client loses some (it alone)"),
 };
 
 #undef F

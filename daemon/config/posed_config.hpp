@@ -237,6 +237,15 @@ struct QueuesSection {
   int state_capacity = 1024;  ///< propagated states between the fusion core and the publisher
 };
 
+/// The Foxglove WebSocket server (foxglove.websocket.v1): Foxglove Studio connects to
+/// ws://ADDRESS:PORT and sees posed's topics live.
+struct FoxgloveSection {
+  bool enabled = false;
+  std::string address = "127.0.0.1";  ///< where it listens; loopback unless asked otherwise
+  int port = 8765;                    ///< 0: an ephemeral port (logged)
+  double max_queued_mb = 8;           ///< per client; beyond this a slow client loses messages
+};
+
 struct WatchdogSection {
   double stage_deadline_s = 1.0;  ///< a stage silent this long stops WATCHDOG=1 [s]
 };
@@ -257,6 +266,7 @@ struct PosedConfig {
   ThreadsSection threads;
   QueuesSection queues;
   WatchdogSection watchdog;
+  FoxgloveSection foxglove;
 };
 
 }  // namespace posed::config

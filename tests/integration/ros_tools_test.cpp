@@ -1,15 +1,25 @@
 // What ROS 2 tools see of posed replaying a simulated drive with a lidar: a separate, ROS 2-typed
 // DDS reader gets rt/posed/cloud in the Velodyne driver's PointCloud2 layout, one per scan posed
 // says it wrote, and a reader that joins late still gets rt/posed/map (transient-local); a
-// recording made with --record-outputs carries the same topics as ros2msg channels.
+// recording made with --record-outputs carries the same topics as ros2msg channels; and
+// Foxglove's own npm client (tests/node) receives every topic over posed's Foxglove WebSocket
+// server and decodes every message with Foxglove's ros2msg parser and CDR reader.
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -188,6 +198,118 @@ TEST(Ros2Tools, RecordOutputsPutsTheTopicsInTheRecordingWithTheirSchemas) {
             hil_helpers::number_after(posed.out(), "  point clouds        "));
   EXPECT_EQ(count["/tf tf2_msgs/msg/TFMessage"],
             count["/posed/pose geometry_msgs/msg/PoseStamped"]);
+}
+
+/// A TCP port nobody listens on right now (the kernel's pick, released again).
+std::uint16_t free_tcp_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t len = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+/// `name` on PATH, or "" (PosedProcess execs a path).
+std::string on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path != nullptr ? path : "/usr/bin:/bin";
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+    const std::filesystem::path candidate =
+        std::filesystem::path(dirs.substr(start, end - start)) / name;
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
+    start = end + 1;
+  }
+  return "";
+}
+
+/// "(/posed/odom 1346, /tf 90)" after `label` in posed's summary -> topic -> count.
+std::map<std::string, long long> counts_in_summary(const std::string& text,
+                                                   const std::string& label) {
+  std::map<std::string, long long> counts;
+  const auto at = text.find(label);
+  if (at == std::string::npos) return counts;
+  const auto open = text.find('(', at), close = text.find(')', at);
+  std::stringstream items(text.substr(open + 1, close - open - 1));
+  std::string topic;
+  long long n = 0;
+  while (items >> topic >> n) {
+    counts[topic] = n;
+    items.ignore(2, ' ');  // ", "
+  }
+  return counts;
+}
+
+TEST(Ros2Tools, FoxglovesOwnClientGetsAndDecodesEveryTopic) {
+  const std::string node = on_path("node");
+  const std::string client_js = source_dir() + "/tests/node/foxglove_client.mjs";
+  ASSERT_FALSE(node.empty()) << "node is not on PATH: run tools/install-deps";
+  ASSERT_TRUE(std::filesystem::exists(source_dir() + "/tests/node/node_modules/@foxglove"))
+      << "the npm modules of tests/node are missing: run tools/install-deps";
+  TempDir posed_dir, client_dir;
+  const std::uint16_t port = free_tcp_port();
+  const std::string config = posed_dir.write(
+      "posed.yaml",
+      dds_yaml() + "foxglove:\n  enabled: true\n  port: " + std::to_string(port) +
+          // room for the whole run, so however slowly the client reads, nothing is dropped
+          "\n  max_queued_mb: 512\n");
+  // posed waits for the client to subscribe to odom before the replay's first sample.
+  PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording(),
+                      "--max-speed", "--wait-subscribers", "20"},
+                     {}, posed_dir);
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (posed.err().find("foxglove: serving") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_NE(posed.err().find("foxglove: serving"), std::string::npos) << posed.err();
+  PosedProcess client({node, client_js, "ws://127.0.0.1:" + std::to_string(port), "--seconds", "60",
+                       "--decode", "--until-close"},
+                      {}, client_dir);
+  ASSERT_EQ(posed.wait_for_exit(60s), 0) << posed.err();
+  ASSERT_EQ(client.wait_for_exit(20s), 0) << client.err();
+  const nlohmann::json report = nlohmann::json::parse(client.out());
+  EXPECT_TRUE(report.value("closedByServer", false));
+  EXPECT_TRUE(report["statuses"].empty()) << report["statuses"].dump();
+  EXPECT_NE(posed.out().find(", 0 dropped for slow clients"), std::string::npos) << posed.out();
+
+  // What posed says it sent on each channel is what the client received, and every message
+  // decodes with Foxglove's ros2msg parser and CDR reader.
+  const auto sent = counts_in_summary(posed.out(), "  foxglove            ");
+  ASSERT_EQ(sent.size(), 9u) << posed.out();
+  const auto& channels = report["channels"];
+  for (const auto& [topic, count] : sent) {
+    ASSERT_TRUE(channels.contains(topic)) << topic;
+    const auto& c = channels[topic];
+    EXPECT_EQ(c["messages"].get<long long>(), count) << topic;
+    EXPECT_EQ(c["decoded"].get<long long>(), count) << topic;
+    EXPECT_EQ(c["decodeErrors"].get<long long>(), 0) << topic << ": " << c.dump();
+    EXPECT_EQ(c["encoding"], "cdr");
+    EXPECT_EQ(c["schemaEncoding"], "ros2msg");
+  }
+  // Every odometry message posed published reached Foxglove (it subscribed before the first).
+  EXPECT_EQ(sent.at("/posed/odom"),
+            hil_helpers::number_after(posed.out(), "  published           "));
+  EXPECT_EQ(sent.at("/posed/cloud"),
+            hil_helpers::number_after(posed.out(), "  point clouds        "));
+  EXPECT_EQ(channels["/posed/odom"]["schemaName"], "nav_msgs/msg/Odometry");
+  EXPECT_EQ(channels["/posed/odom"]["last"]["frameId"], "map");
+  EXPECT_EQ(channels["/tf"]["last"]["transforms"],
+            nlohmann::json::array({"map->odom", "odom->base_link"}));
+  EXPECT_EQ(channels["/tf_static"]["messages"], 1);
+  EXPECT_EQ(channels["/tf_static"]["last"]["transforms"].size(), 3u);
+  const auto& cloud = channels["/posed/cloud"]["last"];
+  EXPECT_EQ(cloud["frameId"], "velodyne");
+  EXPECT_EQ(cloud["pointStep"], 22);
+  EXPECT_EQ(cloud["fields"], nlohmann::json::array({"x:7@0", "y:7@4", "z:7@8", "intensity:7@12",
+                                                    "ring:4@16", "time:7@18"}));
+  EXPECT_EQ(cloud["dataBytes"].get<long long>(), cloud["width"].get<long long>() * 22);
+  EXPECT_EQ(channels["/posed/map"]["last"]["frameId"], "map");
+  EXPECT_EQ(channels["/diagnostics"]["last"]["statuses"][0], "posed: imu");
 }
 
 }  // namespace
