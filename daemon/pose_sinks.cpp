@@ -22,7 +22,18 @@ std::array<double, 36> to_row_major(const Eigen::Matrix<double, 6, 6>& m) {
 
 void PoseSinks::static_transforms() {
   if (!publisher_ || !config_.publish.tf) return;
-  if (!publisher_->publish_tf_static(posed::static_transforms(config_, drivers::wall_now()))) {
+  // A replay's messages carry the recording's time: the transforms wait for its first state,
+  // so a recording of the outputs (and Foxglove's timeline) has them where the data starts.
+  if (!live_clock_) {
+    static_pending_ = true;
+    return;
+  }
+  publish_static_transforms(drivers::wall_now());
+}
+
+void PoseSinks::publish_static_transforms(WallTime stamp) {
+  static_pending_ = false;
+  if (!publisher_->publish_tf_static(posed::static_transforms(config_, stamp))) {
     tally_.failed.fetch_add(1, std::memory_order_relaxed);
   }
 }
@@ -96,6 +107,8 @@ void PoseSinks::odom(const NavState& s) {
 
 void PoseSinks::state(const NavState& s) {
   const WallTime stamp = to_wall_(s.stamp);
+  newest_state_stamp_ = s.stamp;
+  if (static_pending_) publish_static_transforms(stamp);
   // Optimised states (one per scan) go on rt/posed/pose; IMU propagation (when the back end
   // makes it) on rt/posed/odom. An estimator without optimised states (strapdown) has its
   // propagation decimated onto pose.
@@ -129,7 +142,10 @@ void PoseSinks::state(const NavState& s) {
 
 void PoseSinks::status(const pipeline::PipelineStatus& st) {
   dds::StatusMessage msg;
-  msg.stamp = to_wall_(st.stamp);
+  // Live, the report's own time; in a replay the data's (the newest state), so the status sits
+  // with the poses it describes, not decades away from them.
+  msg.stamp = live_clock_ ? to_wall_(st.stamp) : to_wall_(newest_state_stamp_.value_or(st.stamp));
+  const bool publish = live_clock_ || newest_state_stamp_.has_value();
   msg.version = std::string(version_string());
   msg.estimator_mode = std::string(to_string(st.mode));
   const FusionFigures& f = st.estimator;
@@ -200,14 +216,14 @@ void PoseSinks::status(const pipeline::PipelineStatus& st) {
   }
   line += odom_part;
   msg.summary = line;
-  if (!publisher_) {
-    // offline run: nothing to publish
+  if (!publisher_ || !publish) {
+    // offline run, or a replay before its first state: nothing to publish
   } else if (publisher_->publish_status(msg)) {
     ++tally_.status;
   } else {
     tally_.failed.fetch_add(1, std::memory_order_relaxed);
   }
-  if (publisher_ && config_.publish.diagnostics &&
+  if (publisher_ && publish && config_.publish.diagnostics &&
       !publisher_->publish_diagnostics(diagnostics(st, msg.stamp))) {
     tally_.failed.fetch_add(1, std::memory_order_relaxed);
   }

@@ -108,7 +108,9 @@ class PoseSinks {
   /// rt/posed/status and rt/diagnostics, and the line for systemd's STATUS=.
   void status(const pipeline::PipelineStatus& st);
   /// rt/tf_static: base_link -> lidar, camera and thermal frames from the configured
-  /// extrinsics. Once at start (transient-local: later readers get it too).
+  /// extrinsics. Once at start (transient-local: later readers get it too); in a replay with the
+  /// first state, stamped with the data's time. Status and diagnostics, too, carry the data's
+  /// time in a replay (the newest state's) and start with its first state.
   void static_transforms();
 
   /// The last status line ("starting" before the first status); safe from any thread.
@@ -128,6 +130,11 @@ class PoseSinks {
   Duration pose_period_;
   std::uint64_t odom_index_ = 0;
   HostTime next_tf_stamp_;
+  /// publisher thread: the newest state's stamp (a replay's status carries it)
+  std::optional<HostTime> newest_state_stamp_;
+  /// a replay's static transforms wait for its first state
+  bool static_pending_ = false;
+  void publish_static_transforms(WallTime stamp);
   HostTime next_path_stamp_;
   PathBuilder path_;
   /// With each pose: rt/tf (rate-limited) and the path (published at publish.path_rate_hz).
