@@ -55,9 +55,11 @@ void print_channel(const rec::McapChannelStats& s, const rec::McapInspection& r,
   const auto since_start = [&](std::uint64_t log_ns) {
     return static_cast<double>(log_ns - r.first_log_ns) * 1e-9;
   };
-  std::printf("  messages %llu, %.3f MB, %.3f Hz over %.3f s (from +%.3f s to +%.3f s)\n",
-              ull(s.messages), static_cast<double>(s.bytes) / 1e6, s.rate_hz, s.span_s(),
-              since_start(s.first_log_ns), since_start(s.last_log_ns));
+  std::printf(
+      "  messages %llu, %.3f MB (%.0f B each), %.3f Hz over %.3f s (from +%.3f s to +%.3f s)\n",
+      ull(s.messages), static_cast<double>(s.bytes) / 1e6,
+      static_cast<double>(s.bytes) / static_cast<double>(s.messages), s.rate_hz, s.span_s(),
+      since_start(s.first_log_ns), since_start(s.last_log_ns));
   if (s.messages < 2) return;
   std::printf("  period   %.3f ms typical (median interval); %llu gap%s longer than %gx (%.3f ms)",
               static_cast<double>(s.median_interval_ns) * 1e-6, ull(s.gaps), s.gaps == 1 ? "" : "s",
