@@ -16,6 +16,7 @@
 #include "daemon/cloud_output.hpp"
 #include "daemon/dds/publisher.hpp"
 #include "daemon/foxglove/server.hpp"
+#include "daemon/image_output.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
 #include "daemon/output_tap.hpp"
@@ -110,6 +111,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds_config.path = config.publish.path;
   dds_config.cloud = config.publish.cloud;
   dds_config.map = config.publish.map;
+  dds_config.image = config.publish.image;
   dds_config.diagnostics = config.publish.diagnostics;
   std::string error;
   std::unique_ptr<dds::Publisher> publisher;
@@ -199,6 +201,14 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     cloud_output = std::make_unique<CloudOutput>(config, *publisher, to_wall);
   }
 
+  // The front end's annotated image, off the fusion thread, with a camera front end to make it.
+  std::unique_ptr<ImageOutput> image_output;
+  const bool cameras = built.sources.camera(CameraStream::kVisible) != nullptr ||
+                       built.sources.camera(CameraStream::kThermal) != nullptr;
+  if (publisher && config.publish.image && cameras && built.sources.lidar) {
+    image_output = std::make_unique<ImageOutput>(config, *publisher, to_wall);
+  }
+
   // Stamps are this host's clock now live and in a replay with --live-stamps; otherwise a
   // recording's, and how late a message is cannot be told from them.
   PoseSinks sinks(config, publisher.get(), recorder.get(), to_wall, started,
@@ -207,6 +217,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   pipeline::PipelineOutputs outputs;
   outputs.keep_map = !options.map_path.empty();
   outputs.scan_observer = cloud_output.get();
+  outputs.frontend_observer = image_output.get();
   outputs.on_odom = [&sinks](const NavState& s) { sinks.odom(s); };
   outputs.on_state = [&sinks](const NavState& s) { sinks.state(s); };
   outputs.on_status = [&sinks](const pipeline::PipelineStatus& st) { sinks.status(st); };
@@ -300,6 +311,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   }
   pipe.join();
   if (cloud_output) cloud_output->stop();  // its last writes reach the recording too
+  if (image_output) image_output->stop();
   if (recorder && !recorder->close()) {
     POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());
     exit_code = 1;
@@ -321,7 +333,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
                            synthetic,
                            publisher != nullptr,
                            cloud_output.get(),
-                           foxglove_server.get()};
+                           foxglove_server.get(),
+                           image_output.get()};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

@@ -7,6 +7,7 @@
 #include "daemon/cloud_output.hpp"
 #include "daemon/estimator_summary.hpp"
 #include "daemon/foxglove/server.hpp"
+#include "daemon/image_output.hpp"
 #include "daemon/pipeline/pipeline.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/recording/recorder.hpp"
@@ -131,6 +132,16 @@ bool print_run_summary(const RunSummary& r) {
           static_cast<unsigned long long>(c.clouds_replaced),
           static_cast<unsigned long long>(c.maps), static_cast<double>(c.last_map_bytes) / 1e6,
           c.failed ? " (some writes failed)" : "");
+    }
+    if (r.images != nullptr) {
+      const ImageOutputCounters c = r.images->counters();
+      std::printf(
+          "  images              %llu rt/posed/image/compressed (last %.1f kB JPEG, %.1f ms "
+          "to draw and encode on average; %llu replaced by a newer frame)%s\n",
+          static_cast<unsigned long long>(c.images), static_cast<double>(c.last_bytes) / 1e3,
+          c.images + c.failed > 0 ? c.encode_ms_total / static_cast<double>(c.images + c.failed)
+                                  : 0.0,
+          static_cast<unsigned long long>(c.replaced), c.failed ? " (some failed)" : "");
     }
     if (r.foxglove != nullptr) {
       const foxglove::ServerStats fs = r.foxglove->stats();

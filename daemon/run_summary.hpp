@@ -23,6 +23,7 @@ class Recorder;
 }
 
 class CloudOutput;
+class ImageOutput;
 namespace foxglove {
 class Server;
 }
@@ -42,6 +43,7 @@ struct RunSummary {
   bool published = true;                ///< a DDS participant published (false: an offline run)
   const CloudOutput* clouds = nullptr;  ///< stopped; null: no cloud or map output
   const foxglove::Server* foxglove = nullptr;  ///< null: no Foxglove server
+  const ImageOutput* images = nullptr;         ///< stopped; null: no image output
 };
 
 /// Prints it to stdout; false when there was no pose at all (the estimator never aligned).

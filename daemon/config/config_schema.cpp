@@ -88,6 +88,12 @@ const Field kSchema[] = {
       "matched against, in the map frame"),
     F("publish.map_rate_hz", publish.map_rate_hz, "0.2", "Hz", 0.01, 10, "",
       "rt/posed/map messages per second"),
+    F("publish.image", publish.image, "true", "", 0, 0, "",
+      "rt/posed/image/compressed (sensor_msgs/CompressedImage, JPEG): the camera front end's "
+      "tracked image with its features, coloured by track length, ringed where lidar gives "
+      "depth; drawn and encoded off the fusion thread and only while someone reads it"),
+    F("publish.image_rate_hz", publish.image_rate_hz, "5", "Hz", 0.1, 60, "",
+      "at most this many rt/posed/image/compressed messages per second"),
 
     F("imu.source", imu.source, "serial", "", 0, 0, "synthetic|serial|can",
       "where IMU samples come from: the synthetic circle, the A9 over serial, or an IMU on a "

@@ -62,6 +62,8 @@ struct PublishSection {
   double cloud_max_rate_hz = 0;  ///< at most this many clouds per second; 0: every scan [Hz]
   bool map = true;               ///< rt/posed/map: the local map, transient-local
   double map_rate_hz = 0.2;      ///< rt/posed/map messages per second [Hz]
+  bool image = true;             ///< rt/posed/image/compressed: the front end's tracked image
+  double image_rate_hz = 5;      ///< at most this many images per second [Hz]
 };
 
 struct ImuSection {

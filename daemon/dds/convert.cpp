@@ -236,6 +236,25 @@ void fill_cloud(const CloudMessage& msg, sensor_msgs_msg_dds__PointCloud2_& out,
   out.is_dense = msg.is_dense;
 }
 
+void fill_image(const ImageMessage& msg, sensor_msgs_msg_dds__CompressedImage_& out) {
+  out.header.stamp = to_ros_time(msg.stamp);
+  out.header.frame_id = c_str(msg.frame_id);
+  out.format = c_str(msg.format);
+  out.data._buffer = const_cast<std::uint8_t*>(msg.data.data());
+  out.data._length = static_cast<std::uint32_t>(msg.data.size());
+  out.data._maximum = static_cast<std::uint32_t>(msg.data.size());
+  out.data._release = false;  // the buffer belongs to the caller, not to Cyclone
+}
+
+ImageMessage to_plain(const sensor_msgs_msg_dds__CompressedImage_& in) {
+  ImageMessage msg;
+  msg.stamp = from_ros_time(in.header.stamp);
+  msg.frame_id = to_string(in.header.frame_id);
+  msg.format = to_string(in.format);
+  msg.data.assign(in.data._buffer, in.data._buffer + in.data._length);
+  return msg;
+}
+
 CloudMessage to_plain(const sensor_msgs_msg_dds__PointCloud2_& in) {
   CloudMessage msg;
   msg.stamp = from_ros_time(in.header.stamp);

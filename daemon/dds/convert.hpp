@@ -44,6 +44,9 @@ void fill_diagnostics(const DiagnosticsMessage& msg, diagnostic_msgs_msg_dds__Di
 void fill_cloud(const CloudMessage& msg, sensor_msgs_msg_dds__PointCloud2_& out,
                 std::vector<sensor_msgs_msg_dds__PointField_>& fields);
 
+/// Points out's strings and data into `msg` (valid while msg lives, unchanged).
+void fill_image(const ImageMessage& msg, sensor_msgs_msg_dds__CompressedImage_& out);
+
 OdomMessage to_plain(const nav_msgs_msg_dds__Odometry_& in);
 PoseMessage to_plain(const geometry_msgs_msg_dds__PoseStamped_& in);
 StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in);
@@ -53,6 +56,7 @@ DiagnosticsMessage to_plain(const diagnostic_msgs_msg_dds__DiagnosticArray_& in)
 /// Copies the data bytes; a big-endian or organised (height > 1) cloud keeps its bytes as sent
 /// with width = all points.
 CloudMessage to_plain(const sensor_msgs_msg_dds__PointCloud2_& in);
+ImageMessage to_plain(const sensor_msgs_msg_dds__CompressedImage_& in);
 
 /// A C string field as std::string (Cyclone leaves unset strings null).
 std::string to_string(const char* text);

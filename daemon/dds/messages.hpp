@@ -17,10 +17,21 @@
 namespace posed::dds {
 
 /// The topics posed publishes.
-enum class Topic { kOdom, kPose, kStatus, kTf, kTfStatic, kPath, kDiagnostics, kCloud, kMap };
-inline constexpr std::array kAllTopics = {Topic::kOdom,        Topic::kPose,     Topic::kStatus,
-                                          Topic::kTf,          Topic::kTfStatic, Topic::kPath,
-                                          Topic::kDiagnostics, Topic::kCloud,    Topic::kMap};
+enum class Topic {
+  kOdom,
+  kPose,
+  kStatus,
+  kTf,
+  kTfStatic,
+  kPath,
+  kDiagnostics,
+  kCloud,
+  kMap,
+  kImage
+};
+inline constexpr std::array kAllTopics = {
+    Topic::kOdom, Topic::kPose,        Topic::kStatus, Topic::kTf,  Topic::kTfStatic,
+    Topic::kPath, Topic::kDiagnostics, Topic::kCloud,  Topic::kMap, Topic::kImage};
 
 /// DDS topic names: ROS 2 prefixes topics with "rt/", so ROS sees /posed/odom, /tf etc.
 inline constexpr std::string_view kOdomTopic = "rt/posed/odom";
@@ -32,6 +43,8 @@ inline constexpr std::string_view kPathTopic = "rt/posed/path";
 inline constexpr std::string_view kDiagnosticsTopic = "rt/diagnostics";
 inline constexpr std::string_view kCloudTopic = "rt/posed/cloud";
 inline constexpr std::string_view kMapTopic = "rt/posed/map";
+/// image_transport's name for the compressed form of the image /posed/image
+inline constexpr std::string_view kImageTopic = "rt/posed/image/compressed";
 
 /// The DDS topic name of `topic`, e.g. "rt/posed/odom".
 constexpr std::string_view topic_name(Topic topic) {
@@ -54,6 +67,8 @@ constexpr std::string_view topic_name(Topic topic) {
       return kCloudTopic;
     case Topic::kMap:
       return kMapTopic;
+    case Topic::kImage:
+      return kImageTopic;
   }
   return {};
 }
@@ -77,6 +92,8 @@ constexpr std::string_view ros_type_name(Topic topic) {
     case Topic::kCloud:
     case Topic::kMap:
       return "sensor_msgs/msg/PointCloud2";
+    case Topic::kImage:
+      return "sensor_msgs/msg/CompressedImage";
   }
   return {};
 }
@@ -85,12 +102,13 @@ constexpr std::string_view ros_type_name(Topic topic) {
 constexpr std::string_view ros_topic_name(Topic topic) { return topic_name(topic).substr(2); }
 
 /// Accepts the DDS name ("rt/posed/odom", "rt/tf"), the ROS name ("/posed/odom", "/tf") or the
-/// last part ("odom", "tf_static").
+/// last part ("odom", "tf_static"; "image" for rt/posed/image/compressed).
 constexpr bool parse_topic(std::string_view text, Topic& topic) {
   for (Topic t : kAllTopics) {
     const std::string_view full = topic_name(t);
     const std::string_view ros = full.substr(2);
-    const std::string_view short_name = full.substr(full.rfind('/') + 1);
+    const std::string_view short_name =
+        t == Topic::kImage ? "image" : full.substr(full.rfind('/') + 1);
     if (text == full || text == ros || text == short_name) {
       topic = t;
       return true;
@@ -199,6 +217,15 @@ struct CloudMessage {
   std::vector<std::uint8_t> data;
   /// no point has a non-finite coordinate
   bool is_dense = true;
+};
+
+/// sensor_msgs/CompressedImage: rt/posed/image/compressed.
+struct ImageMessage {
+  /// time the image was taken (wall clock, UNIX epoch) [ns]
+  WallTime stamp;
+  std::string frame_id;
+  std::string format;  ///< "jpeg"
+  std::vector<std::uint8_t> data;
 };
 
 /// posed_msgs/StreamStatus: health of one input stream.
@@ -351,6 +378,8 @@ struct DdsConfig {
   bool cloud = true;
   /// create a writer for rt/posed/map (publish.map)
   bool map = true;
+  /// create a writer for rt/posed/image/compressed (publish.image)
+  bool image = true;
   /// DDS Security; empty files: none
   DdsSecurityFiles security;
 };

@@ -105,6 +105,8 @@ const dds_topic_descriptor_t& descriptor(Topic topic) {
     case Topic::kCloud:
     case Topic::kMap:
       return sensor_msgs_msg_dds__PointCloud2__desc;
+    case Topic::kImage:
+      return sensor_msgs_msg_dds__CompressedImage__desc;
   }
   return nav_msgs_msg_dds__Odometry__desc;
 }
@@ -199,9 +201,9 @@ dds_qos_t* make_topic_qos(Topic topic) {
     // published as map servers do: the latest one reaches a reader that joins later.
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  } else if (topic == Topic::kCloud) {
-    // A scan is ~0.7 MB: two held per reader bound the memory a slow reader costs; an older
-    // scan is worth nothing once a newer one exists.
+  } else if (topic == Topic::kCloud || topic == Topic::kImage) {
+    // A scan is ~1.2 MB, an image ~50 kB: two held per reader bound the memory a slow reader
+    // costs; an older one is worth nothing once a newer one exists.
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 2);
   } else {

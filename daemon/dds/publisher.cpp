@@ -42,6 +42,7 @@ struct Publisher::Impl {
   sensor_msgs_msg_dds__PointCloud2_ cloud_sample{};
   std::vector<sensor_msgs_msg_dds__PointField_> cloud_fields;
   sensor_msgs_msg_dds__PointCloud2_ map_sample{};
+  sensor_msgs_msg_dds__CompressedImage_ image_sample{};
   std::vector<sensor_msgs_msg_dds__PointField_> map_fields;
   std::atomic<std::uint64_t> write_failures{0};
   MessageTap* tap = nullptr;
@@ -89,7 +90,8 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
       (!config.tf || (make_writer(Topic::kTf) && make_writer(Topic::kTfStatic))) &&
       (!config.path || make_writer(Topic::kPath)) &&
       (!config.diagnostics || make_writer(Topic::kDiagnostics)) &&
-      (!config.cloud || make_writer(Topic::kCloud)) && (!config.map || make_writer(Topic::kMap));
+      (!config.cloud || make_writer(Topic::kCloud)) && (!config.map || make_writer(Topic::kMap)) &&
+      (!config.image || make_writer(Topic::kImage));
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
 
   impl->map_frame = config.map_frame;
@@ -151,6 +153,11 @@ bool Publisher::publish_cloud(const CloudMessage& msg) {
 bool Publisher::publish_map(const CloudMessage& msg) {
   detail::fill_cloud(msg, impl_->map_sample, impl_->map_fields);
   return impl_->write(Topic::kMap, &impl_->map_sample, msg.stamp);
+}
+
+bool Publisher::publish_image(const ImageMessage& msg) {
+  detail::fill_image(msg, impl_->image_sample);
+  return impl_->write(Topic::kImage, &impl_->image_sample, msg.stamp);
 }
 
 void Publisher::set_tap(MessageTap* tap) { impl_->tap = tap; }

@@ -46,6 +46,8 @@ class Publisher {
   bool publish_cloud(const CloudMessage& msg);
   /// rt/posed/map, transient-local (false, nothing sent, without DdsConfig::map).
   bool publish_map(const CloudMessage& msg);
+  /// rt/posed/image/compressed (false, nothing sent, without DdsConfig::image).
+  bool publish_image(const ImageMessage& msg);
 
   /// Hands every message written from now on to `tap` too, as ROS 2 CDR (MessageTap). Set it
   /// before the first publish_*; it must outlive the Publisher's writes. nullptr: none.

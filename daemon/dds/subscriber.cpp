@@ -149,6 +149,14 @@ std::size_t Subscriber::take_cloud(Topic topic, std::vector<Received<CloudMessag
       });
 }
 
+std::size_t Subscriber::take_image(std::vector<Received<ImageMessage>>& out) {
+  return impl_->take<sensor_msgs_msg_dds__CompressedImage_>(
+      Topic::kImage, out,
+      [](const sensor_msgs_msg_dds__CompressedImage_& s, Received<ImageMessage>& r) {
+        r.frame_id = detail::to_string(s.header.frame_id);
+      });
+}
+
 std::uint32_t Subscriber::matched_publishers(Topic topic) const {
   const dds_entity_t reader = impl_->reader(topic);
   if (reader == 0) return 0;

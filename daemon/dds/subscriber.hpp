@@ -53,6 +53,7 @@ class Subscriber {
   std::size_t take_diagnostics(std::vector<Received<DiagnosticsMessage>>& out);
   /// rt/posed/cloud or rt/posed/map (`topic`).
   std::size_t take_cloud(Topic topic, std::vector<Received<CloudMessage>>& out);
+  std::size_t take_image(std::vector<Received<ImageMessage>>& out);
 
   /// Writers currently matched on `topic` [count].
   std::uint32_t matched_publishers(Topic topic) const;

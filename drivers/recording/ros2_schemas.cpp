@@ -240,6 +240,15 @@ std::string_view posed_status_schema() {
   return s;
 }
 
+std::string_view compressed_image_schema() {
+  static const std::string s =
+      join({"std_msgs/Header header\n"
+            "string format\n"
+            "uint8[] data\n",
+            kHeaderDef, kTimeDef});
+  return s;
+}
+
 std::string_view schema_for(std::string_view type_name) {
   if (type_name == kPoseStampedName) return pose_stamped_schema();
   if (type_name == kOdometryName) return odometry_schema();
@@ -248,6 +257,7 @@ std::string_view schema_for(std::string_view type_name) {
   if (type_name == kDiagnosticArrayName) return diagnostic_array_schema();
   if (type_name == kPointCloud2Name) return point_cloud2_schema();
   if (type_name == kPosedStatusName) return posed_status_schema();
+  if (type_name == kCompressedImageName) return compressed_image_schema();
   return {};
 }
 

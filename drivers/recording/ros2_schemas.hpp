@@ -17,6 +17,7 @@ inline constexpr std::string_view kPathName = "nav_msgs/msg/Path";
 inline constexpr std::string_view kDiagnosticArrayName = "diagnostic_msgs/msg/DiagnosticArray";
 inline constexpr std::string_view kPointCloud2Name = "sensor_msgs/msg/PointCloud2";
 inline constexpr std::string_view kPosedStatusName = "posed_msgs/msg/Status";
+inline constexpr std::string_view kCompressedImageName = "sensor_msgs/msg/CompressedImage";
 
 /// Full ros2msg definition (the type, then each dependency after a `===` line and `MSG: type`).
 std::string_view pose_stamped_schema();
@@ -26,6 +27,7 @@ std::string_view path_schema();
 std::string_view diagnostic_array_schema();
 std::string_view point_cloud2_schema();
 std::string_view posed_status_schema();
+std::string_view compressed_image_schema();
 
 /// The definition of `type_name` (one of the k*Name above); empty for a type posed does not
 /// write.

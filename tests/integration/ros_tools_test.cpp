@@ -18,6 +18,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -310,6 +311,52 @@ TEST(Ros2Tools, FoxglovesOwnClientGetsAndDecodesEveryTopic) {
   EXPECT_EQ(cloud["dataBytes"].get<long long>(), cloud["width"].get<long long>() * 22);
   EXPECT_EQ(channels["/posed/map"]["last"]["frameId"], "map");
   EXPECT_EQ(channels["/diagnostics"]["last"]["statuses"][0], "posed: imu");
+}
+
+TEST(Ros2Tools, TheFrontEndsImageArrivesAsAJpegOfTheTrackedImage) {
+  TempDir dir;
+  const std::string drive = dir.file("cameras.mcap");
+  {
+    TempDir sim_dir;
+    PosedProcess sim(
+        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night", "--duration",
+         "3", "--seed", "9", "--config", source_dir() + "/config/posed.yaml", "-o", drive},
+        {}, sim_dir);
+    ASSERT_EQ(sim.wait_for_exit(60s), 0) << sim.err();
+  }
+  const std::string config = dir.write("posed.yaml", dds_yaml());
+  std::string error;
+  const std::array topics = {dds::Topic::kPose, dds::Topic::kImage};
+  auto reader = dds::Subscriber::create(reader_config(), topics, error);
+  ASSERT_TRUE(reader) << error;
+  PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", drive,
+                      "--max-speed", "--wait-subscribers", "5"},
+                     {}, dir);
+  std::vector<dds::Received<dds::ImageMessage>> images;
+  std::optional<int> exit_code;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (!exit_code && std::chrono::steady_clock::now() < deadline) {
+    reader->wait(Duration::from_ms(20));
+    reader->take_image(images);  // keep up: the reader holds 2 at most
+    exit_code = posed.wait_for_exit(1ms);
+  }
+  ASSERT_EQ(exit_code, 0) << posed.err();
+  reader->take_image(images);
+  const long long written = hil_helpers::number_after(posed.out(), "  images              ");
+  ASSERT_GT(written, 5) << posed.out();  // 5 Hz over the ~2.5 s the front end runs
+  EXPECT_EQ(static_cast<long long>(images.size()), written);
+  for (const auto& r : images) {
+    EXPECT_EQ(r.frame_id, "camera_color_optical_frame");
+    EXPECT_EQ(r.msg.format, "jpeg");
+    const cv::Mat decoded = cv::imdecode(r.msg.data, cv::IMREAD_COLOR);
+    ASSERT_FALSE(decoded.empty()) << "not a JPEG";
+    EXPECT_EQ(decoded.cols, 640);  // the D435i's colour stream as simulated
+    EXPECT_EQ(decoded.rows, 480);
+  }
+  // At most 5 Hz of the data's time.
+  for (std::size_t i = 1; i < images.size(); ++i) {
+    EXPECT_GE((images[i].msg.stamp - images[i - 1].msg.stamp).seconds(), 0.2 - 1e-3);
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
@@ -270,6 +271,28 @@ void print_cloud(const dds::Received<dds::CloudMessage>& r, bool as_csv) {
       cloud_fields(m).c_str());
 }
 
+void print_image_header_csv() {
+  std::printf("stamp_s,receive_s,latency_ms,frame_id,format,bytes,width_px,height_px\n");
+}
+
+/// One line per image: format, size, and its dimensions once decoded (0 x 0: it does not decode).
+void print_image(const dds::Received<dds::ImageMessage>& r, bool as_csv) {
+  const auto& m = r.msg;
+  const double lat = (r.received_wall - m.stamp).seconds() * 1e3;
+  const cv::Mat decoded = cv::imdecode(cv::Mat(1, static_cast<int>(m.data.size()), CV_8UC1,
+                                               const_cast<std::uint8_t*>(m.data.data())),
+                                       cv::IMREAD_UNCHANGED);
+  if (as_csv) {
+    std::printf("%s,%s,%.3f,%s,%s,%zu,%d,%d\n", stamp_text(m.stamp).c_str(),
+                stamp_text(r.received_wall).c_str(), lat, csv(r.frame_id).c_str(),
+                csv(m.format).c_str(), m.data.size(), decoded.cols, decoded.rows);
+    return;
+  }
+  std::printf("image %s s in %s  %s %.1f kB, %d x %d px\n", stamp_text(m.stamp).c_str(),
+              r.frame_id.c_str(), m.format.c_str(), static_cast<double>(m.data.size()) / 1e3,
+              decoded.cols, decoded.rows);
+}
+
 void print_diagnostics_header_csv() {
   std::printf("stamp_s,receive_s,latency_ms,level,name,message,hardware_id,values\n");
 }
@@ -423,6 +446,7 @@ void write_tum(std::FILE*, const dds::Received<dds::TfMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::PathMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::DiagnosticsMessage>&) {}
 void write_tum(std::FILE*, const dds::Received<dds::CloudMessage>&) {}
+void write_tum(std::FILE*, const dds::Received<dds::ImageMessage>&) {}
 
 /// The stamp a message's latency is measured from (a tf message: its first transform's).
 WallTime stamp_of(const dds::OdomMessage& m) { return m.stamp; }
@@ -431,6 +455,7 @@ WallTime stamp_of(const dds::StatusMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::PathMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::DiagnosticsMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::CloudMessage& m) { return m.stamp; }
+WallTime stamp_of(const dds::ImageMessage& m) { return m.stamp; }
 WallTime stamp_of(const dds::TfMessage& m) {
   return m.transforms.empty() ? WallTime{} : m.transforms.front().stamp;
 }
@@ -473,7 +498,7 @@ int run_echo(int argc, char** argv) {
   std::string enclave;
   app.add_option(
          "topic", topic_arg,
-         "odom, pose, status, tf, tf_static, path, diagnostics, cloud, map, or the full DDS "
+         "odom, pose, status, tf, tf_static, path, diagnostics, cloud, map, image, or the full DDS "
          "name (rt/posed/odom, rt/tf) or ROS name")
       ->capture_default_str();
   app.add_flag("--csv", as_csv,
@@ -500,9 +525,9 @@ int run_echo(int argc, char** argv) {
   if (!dds::parse_topic(topic_arg, topic)) {
     std::fprintf(stderr,
                  "posectl echo: unknown topic '%s' (expected odom, pose, status, path, tf, "
-                 "tf_static, diagnostics, cloud, map, or their DDS names "
-                 "rt/posed/{odom,pose,status,path,cloud,map}, rt/tf, rt/tf_static, "
-                 "rt/diagnostics)\n",
+                 "tf_static, diagnostics, cloud, map, image, or their DDS names "
+                 "rt/posed/{odom,pose,status,path,cloud,map}, rt/posed/image/compressed, rt/tf, "
+                 "rt/tf_static, rt/diagnostics)\n",
                  topic_arg.c_str());
     return 2;
   }
@@ -545,6 +570,7 @@ int run_echo(int argc, char** argv) {
     if (topic == dds::Topic::kPath) print_path_header_csv();
     if (topic == dds::Topic::kDiagnostics) print_diagnostics_header_csv();
     if (topic == dds::Topic::kCloud || topic == dds::Topic::kMap) print_cloud_header_csv();
+    if (topic == dds::Topic::kImage) print_image_header_csv();
   }
   std::fprintf(stderr, "posectl echo: listening on %s (domain %u)\n", topic_name.c_str(), domain);
 
@@ -596,6 +622,10 @@ int run_echo(int argc, char** argv) {
       case dds::Topic::kMap:
         drain<dds::CloudMessage>([&](auto& v) { subscriber->take_cloud(topic, v); }, print_cloud,
                                  as_csv, nullptr, stats, count);
+        break;
+      case dds::Topic::kImage:
+        drain<dds::ImageMessage>([&](auto& v) { subscriber->take_image(v); }, print_image, as_csv,
+                                 nullptr, stats, count);
         break;
     }
   }

@@ -7,17 +7,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/vision/feature_overlay.hpp"
+
 namespace posed::posectl {
 
 namespace {
-
-/// White text outlined in black at the top left, readable on any image.
-void label(cv::Mat& image, const std::string& text) {
-  cv::putText(image, text, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 3,
-              cv::LINE_AA);
-  cv::putText(image, text, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(255, 255, 255), 1,
-              cv::LINE_AA);
-}
 
 /// A grey panel in colour with a caption; black when the mode did not build the image.
 cv::Mat panel(const cv::Mat& grey, const cv::Size& size, const std::string& caption) {
@@ -28,14 +22,8 @@ cv::Mat panel(const cv::Mat& grey, const cv::Size& size, const std::string& capt
     if (bgr.size() != size) cv::resize(bgr, bgr, size);
     bgr.copyTo(out);
   }
-  if (!caption.empty()) label(out, caption);
+  if (!caption.empty()) vision::draw_label(out, caption);
   return out;
-}
-
-/// Track length as colour: new features red, through yellow, to green at 20 frames and more.
-cv::Scalar track_colour(std::uint32_t length) {
-  const double s = std::min(1.0, static_cast<double>(length - 1) / 19.0);
-  return s < 0.5 ? cv::Scalar(0, 510 * s, 255) : cv::Scalar(0, 255, 510 * (1 - s));
 }
 
 }  // namespace
@@ -54,29 +42,7 @@ void FrontendSnapshots::on_frame(const vision::FrontendFrame& frame,
   const cv::Mat& tracked = frontend.tracked_grey();
   if (tracked.empty()) return;
   const cv::Size size = tracked.size();
-  cv::Mat features = panel(tracked, size, "");
-  int with_depth = 0;
-  for (const vision::FrontendFeature& f : frame.features) {
-    const cv::Point2f p(f.pixel_px.x(), f.pixel_px.y());
-    cv::circle(features, p, 3, track_colour(f.track_length), cv::FILLED, cv::LINE_AA);
-    if (!std::isnan(f.depth_m)) {
-      cv::circle(features, p, 6, cv::Scalar(255, 200, 0), 1, cv::LINE_AA);
-      if (with_depth++ % 8 == 0) {
-        char text[16];
-        std::snprintf(text, sizeof text, "%.1f", f.depth_m);
-        cv::putText(features, text, p + cv::Point2f(7, -7), cv::FONT_HERSHEY_PLAIN, 0.8,
-                    cv::Scalar(255, 200, 0), 1, cv::LINE_AA);
-      }
-    }
-  }
-  char caption[160];
-  std::snprintf(
-      caption, sizeof caption, "%s: %d features, %d tracked, %d with lidar depth, match %.0f %%",
-      std::string(vision::to_string(frame.mode)).c_str(), frame.counts.features,
-      frame.counts.ransac_inliers, frame.counts.depth_associated,
-      100.0 * (std::isnan(frame.counts.match_success_rate()) ? 0.0
-                                                             : frame.counts.match_success_rate()));
-  label(features, caption);
+  const cv::Mat features = vision::feature_overlay(tracked, frame);
   const auto q = [](const vision::ImageQuality& quality, const char* name) {
     char text[96];
     if (!quality.valid) {
