@@ -39,7 +39,7 @@ int main(int argc, char** argv) noexcept try {
   app.add_option("--record-outputs", options.record_outputs,
                  "with --record: which DDS outputs to record too, as ROS 2 (ros2msg/CDR) channels "
                  "Foxglove opens: comma-separated from tf, tf_static, path, diagnostics, status, "
-                 "cloud, map; all; or none (clouds are ~0.7 MB a scan)")
+                 "cloud, map, image; all; or none (a cloud is ~1.2 MB a scan)")
       ->capture_default_str();
   app.add_option("--save-map", options.map_path,
                  "at the end of the run (or on SIGTERM), write the lidar map to this PCD file "

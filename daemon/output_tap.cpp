@@ -24,8 +24,8 @@ bool parse_record_outputs(const std::string& text, std::vector<dds::Topic>& topi
     dds::Topic t{};
     if (!dds::parse_topic(item, t) || t == dds::Topic::kOdom || t == dds::Topic::kPose) {
       error = "--record-outputs: '" + item +
-              "' is not one of tf, tf_static, path, diagnostics, status, cloud, map (or all, "
-              "none); odom and pose are always recorded";
+              "' is not one of tf, tf_static, path, diagnostics, status, cloud, map, image (or "
+              "all, none); odom and pose are always recorded";
       return false;
     }
     topics.push_back(t);
@@ -53,10 +53,10 @@ OutputTap::OutputTap(drivers::recording::Recorder* recorder,
   if (recorder_ == nullptr) return;
   for (dds::Topic t : record_topics) {
     if (t == dds::Topic::kOdom || t == dds::Topic::kPose) continue;
-    const bool cloud = t == dds::Topic::kCloud || t == dds::Topic::kMap;
-    // ~0.7 MB a scan: 64 queued bound what a stalled disk costs to ~45 MB.
+    const bool large = t == dds::Topic::kCloud || t == dds::Topic::kMap || t == dds::Topic::kImage;
+    // ~1.2 MB a scan: 64 queued bound what a stalled disk costs to ~80 MB.
     record_channel_[static_cast<std::size_t>(t)] =
-        recorder_->add_ros2_channel(dds::ros_topic_name(t), dds::ros_type_name(t), cloud ? 64 : 0);
+        recorder_->add_ros2_channel(dds::ros_topic_name(t), dds::ros_type_name(t), large ? 64 : 0);
   }
 }
 
