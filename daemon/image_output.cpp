@@ -1,13 +1,13 @@
 #include "daemon/image_output.hpp"
 
 #include <chrono>
-#include <opencv2/imgcodecs.hpp>
 #include <utility>
 #include <vector>
 
 #include "core/vision/feature_overlay.hpp"
 #include "core/vision/visual_frontend.hpp"
 #include "daemon/dds/publisher.hpp"
+#include "drivers/camera/mjpeg_decoder.hpp"
 
 namespace posed {
 
@@ -48,8 +48,8 @@ void ImageOutput::on_frame(const vision::FrontendFrame& frame,
 void ImageOutput::run() {
   cv::Mat grey;
   vision::FrontendFrame frame;
-  std::vector<std::uint8_t> jpeg;
-  const std::vector<int> params = {cv::IMWRITE_JPEG_QUALITY, 80};
+  std::vector<std::byte> jpeg;
+  cv::Mat overlay;
   dds::ImageMessage msg;
   msg.frame_id = config_.dds.camera_frame;  // features are in the visible image's geometry
   msg.format = "jpeg";
@@ -63,14 +63,21 @@ void ImageOutput::run() {
     lock.unlock();
     // Outside the lock: the fusion thread copies the next frame while this one is encoded.
     const auto began = std::chrono::steady_clock::now();
-    bool ok = cv::imencode(".jpg", vision::feature_overlay(grey, frame), jpeg, params);
+    // libturbojpeg (as the MJPEG decoder), not OpenCV's imgcodecs: linking that into posed
+    // brings codec libraries whose start-up calls fall outside the unit's system-call filter.
+    overlay = vision::feature_overlay(grey, frame);
+    bool ok = overlay.isContinuous() &&
+              drivers::camera::encode_jpeg(
+                  {reinterpret_cast<const std::byte*>(overlay.data), overlay.total() * 3},
+                  static_cast<std::uint32_t>(overlay.cols),
+                  static_cast<std::uint32_t>(overlay.rows), PixelFormat::kBgr8, 80, jpeg);
     const double encode_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - began).count();
     if (ok) {
       msg.stamp = to_wall_(frame.stamp);
-      msg.data.swap(jpeg);
+      const auto* bytes = reinterpret_cast<const std::uint8_t*>(jpeg.data());
+      msg.data.assign(bytes, bytes + jpeg.size());
       ok = publisher_.publish_image(msg);
-      msg.data.swap(jpeg);
     }
     lock.lock();
     counters_.encode_ms_total += encode_ms;

@@ -13,13 +13,10 @@
 #include <thread>
 
 #include "daemon/build_info.hpp"
-#include "daemon/cloud_output.hpp"
 #include "daemon/dds/publisher.hpp"
-#include "daemon/foxglove/server.hpp"
-#include "daemon/image_output.hpp"
+#include "daemon/extra_outputs.hpp"
 #include "daemon/notify/sd_notify.hpp"
 #include "daemon/notify/stage_watchdog.hpp"
-#include "daemon/output_tap.hpp"
 #include "daemon/pipeline/camera_calibration.hpp"
 #include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/latency_histogram.hpp"
@@ -164,49 +161,16 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     POSED_LOG_INFO("recording raw streams and poses to %s", options.record_path.c_str());
   }
 
-  // The DDS outputs beside DDS: into the recording as ros2msg channels.
-  std::vector<dds::Topic> record_outputs;
-  if (recorder && !parse_record_outputs(options.record_outputs, record_outputs, error)) {
+  // Besides poses and status: the recording's and Foxglove's copies, clouds, the image.
+  ExtraOutputs extra;
+  const ExtraOutputsSetup extra_setup{&options.config_path, options.record_outputs,
+                                      built.sources.lidar != nullptr,
+                                      built.sources.camera(CameraStream::kVisible) != nullptr ||
+                                          built.sources.camera(CameraStream::kThermal) != nullptr,
+                                      to_wall};
+  if (!extra.open(config, publisher.get(), recorder.get(), extra_setup, error)) {
     POSED_LOG_ERROR("%s", error.c_str());
     return 1;
-  }
-  // Foxglove Studio live: every topic DDS carries, on the WebSocket server's own thread.
-  std::unique_ptr<foxglove::Server> foxglove_server;
-  std::vector<dds::Topic> served;
-  if (publisher && config.foxglove.enabled) {
-    foxglove::ServerOptions fox;
-    fox.address = config.foxglove.address;
-    fox.port = static_cast<std::uint16_t>(config.foxglove.port);
-    fox.name = std::string(version_string());
-    fox.max_queued_bytes_per_client = static_cast<std::size_t>(config.foxglove.max_queued_mb * 1e6);
-    foxglove_server = foxglove::Server::start(fox, error);
-    if (!foxglove_server) {
-      POSED_LOG_ERROR("%s (foxglove.address, foxglove.port in %s)", error.c_str(),
-                      options.config_path.c_str());
-      return 1;
-    }
-    for (dds::Topic t : dds::kAllTopics) {
-      if (publisher->has_writer(t)) served.push_back(t);
-    }
-    POSED_LOG_INFO("foxglove: serving %zu topics on ws://%s:%u", served.size(),
-                   config.foxglove.address.c_str(), foxglove_server->port());
-  } else if (config.foxglove.enabled) {
-    POSED_LOG_NOTICE("foxglove.enabled, but this run publishes nothing: no Foxglove server");
-  }
-  OutputTap output_tap(recorder.get(), record_outputs, foxglove_server.get(), served);
-  if (publisher) publisher->set_tap(&output_tap);
-  // Point clouds are built and written off the fusion thread, only with a lidar to make them.
-  std::unique_ptr<CloudOutput> cloud_output;
-  if (publisher && built.sources.lidar && (config.publish.cloud || config.publish.map)) {
-    cloud_output = std::make_unique<CloudOutput>(config, *publisher, to_wall);
-  }
-
-  // The front end's annotated image, off the fusion thread, with a camera front end to make it.
-  std::unique_ptr<ImageOutput> image_output;
-  const bool cameras = built.sources.camera(CameraStream::kVisible) != nullptr ||
-                       built.sources.camera(CameraStream::kThermal) != nullptr;
-  if (publisher && config.publish.image && cameras && built.sources.lidar) {
-    image_output = std::make_unique<ImageOutput>(config, *publisher, to_wall);
   }
 
   // Stamps are this host's clock now live and in a replay with --live-stamps; otherwise a
@@ -216,8 +180,8 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   sinks.static_transforms();
   pipeline::PipelineOutputs outputs;
   outputs.keep_map = !options.map_path.empty();
-  outputs.scan_observer = cloud_output.get();
-  outputs.frontend_observer = image_output.get();
+  outputs.scan_observer = extra.scan_observer();
+  outputs.frontend_observer = extra.frontend_observer();
   outputs.on_odom = [&sinks](const NavState& s) { sinks.odom(s); };
   outputs.on_state = [&sinks](const NavState& s) { sinks.state(s); };
   outputs.on_status = [&sinks](const pipeline::PipelineStatus& st) { sinks.status(st); };
@@ -233,8 +197,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     const HostTime give_up = drivers::host_now() + Duration::from_seconds(wait_s);
     // A reader: a DDS reader of odom or pose, or a Foxglove client subscribed to either.
     while (publisher->matched_subscribers(dds::Topic::kOdom) == 0 &&
-           publisher->matched_subscribers(dds::Topic::kPose) == 0 &&
-           !output_tap.wants(dds::Topic::kOdom) && !output_tap.wants(dds::Topic::kPose) &&
+           publisher->matched_subscribers(dds::Topic::kPose) == 0 && !extra.foxglove_reader() &&
            drivers::host_now() < give_up) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
@@ -310,8 +273,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     }
   }
   pipe.join();
-  if (cloud_output) cloud_output->stop();  // its last writes reach the recording too
-  if (image_output) image_output->stop();
+  extra.stop();  // the last clouds and images reach the recording too
   if (recorder && !recorder->close()) {
     POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());
     exit_code = 1;
@@ -320,21 +282,10 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   if (!options.map_path.empty() && !save_map(pipe, options.map_path, to_wall, map_line))
     exit_code = 1;
 
-  const RunSummary summary{config,
-                           options,
-                           pipe,
-                           sinks,
-                           started,
-                           pipeline_started,
-                           replay_streams,
-                           built_has_lidar,
-                           recorder.get(),
-                           map_line,
-                           synthetic,
-                           publisher != nullptr,
-                           cloud_output.get(),
-                           foxglove_server.get(),
-                           image_output.get()};
+  const RunSummary summary{config,         options,          pipe,           sinks,
+                           started,        pipeline_started, replay_streams, built_has_lidar,
+                           recorder.get(), map_line,         synthetic,      publisher != nullptr,
+                           extra.clouds(), extra.foxglove(), extra.images()};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

@@ -92,7 +92,7 @@ ConvertStatus MjpegDecoder::decode(std::span<const std::byte> jpeg, std::uint32_
   return ConvertStatus::kDecodeError;
 }
 
-bool encode_jpeg_for_test(std::span<const std::byte> src, std::uint32_t width, std::uint32_t height,
+bool encode_jpeg(std::span<const std::byte> src, std::uint32_t width, std::uint32_t height,
                           PixelFormat format, int quality, std::vector<std::byte>& out) {
   const int pf = tj_pixel_format(format);
   if (pf < 0) return false;

@@ -43,9 +43,10 @@ class MjpegDecoder {
   MjpegCounters counters_;
 };
 
-/// Encodes `src` (kBgr8 or kMono8) as a JPEG into `out` (resized); for tests and benchmarks that
-/// need real MJPEG frames. Returns false on failure.
-bool encode_jpeg_for_test(std::span<const std::byte> src, std::uint32_t width, std::uint32_t height,
-                          PixelFormat format, int quality, std::vector<std::byte>& out);
+/// Encodes `src` (kBgr8 or kMono8, rows packed) as a JPEG into `out` (resized): rt/posed/image/
+/// compressed, and tests and benchmarks that need real MJPEG frames. Returns false on failure.
+/// libturbojpeg, as the decoder, so posed needs no image codec library beyond it.
+bool encode_jpeg(std::span<const std::byte> src, std::uint32_t width, std::uint32_t height,
+                 PixelFormat format, int quality, std::vector<std::byte>& out);
 
 }  // namespace posed::drivers::camera

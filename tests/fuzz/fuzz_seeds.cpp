@@ -183,10 +183,10 @@ bool camera_frame_seeds(const fs::path& dir, const fs::path& realdata) {
     for (std::size_t c = 0; c < 3; ++c) bgr[3 * i + c] = grey[i];
   }
   std::vector<std::byte> jpeg;
-  if (cam::encode_jpeg_for_test(grey, 640, 24, posed::PixelFormat::kMono8, 85, jpeg)) {
+  if (cam::encode_jpeg(grey, 640, 24, posed::PixelFormat::kMono8, 85, jpeg)) {
     ok = frame_seed(dir / "mjpeg_grey_640x24", WireFormat::kMjpeg, 2, 640, 24, 0, jpeg) && ok;
   }
-  if (cam::encode_jpeg_for_test(bgr, 640, 24, posed::PixelFormat::kBgr8, 85, jpeg)) {
+  if (cam::encode_jpeg(bgr, 640, 24, posed::PixelFormat::kBgr8, 85, jpeg)) {
     ok = frame_seed(dir / "mjpeg_bgr_640x24", WireFormat::kMjpeg, 0, 640, 24, 0, jpeg) && ok;
     ok = frame_seed(dir / "mjpeg_bgr_640x24_cut", WireFormat::kMjpeg, 0, 640, 24, 0,
                     std::span(jpeg).first(jpeg.size() / 2)) &&

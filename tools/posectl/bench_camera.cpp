@@ -152,7 +152,7 @@ int bench_camera() {
       bgr[3 * i] = bgr[3 * i + 1] = bgr[3 * i + 2] = static_cast<std::byte>(grey[i]);
     }
     std::vector<std::byte> jpeg;
-    if (!cam::encode_jpeg_for_test(bgr, 640, 512, PixelFormat::kBgr8, 85, jpeg)) {
+    if (!cam::encode_jpeg(bgr, 640, 512, PixelFormat::kBgr8, 85, jpeg)) {
       std::fprintf(stderr, "posectl bench camera: JPEG encode failed\n");
       return 1;
     }

@@ -128,7 +128,7 @@ TEST(Mjpeg, DecodesWhatTurboJpegEncodedAndReportsCorruption) {
     }
   }
   std::vector<std::byte> jpeg;
-  ASSERT_TRUE(encode_jpeg_for_test(bgr, w, h, PixelFormat::kBgr8, 95, jpeg));
+  ASSERT_TRUE(encode_jpeg(bgr, w, h, PixelFormat::kBgr8, 95, jpeg));
   MjpegDecoder dec;
   std::vector<std::byte> out(bgr.size());
   ASSERT_EQ(dec.decode(jpeg, w, h, {out, 0}), ConvertStatus::kOk);
