@@ -16,16 +16,18 @@ void print_visual_summary(const FusionFigures& f) {
     }
     any = true;
     std::printf(
-        "  %-7s factors     %llu between factors from %llu frames; gate %s (left %llu, rejoined "
-        "%llu times, %llu intervals gated out); %llu without frames, %llu failed, %llu "
-        "implausible; last omega %.2f, confidence %.2f, %d inliers, reprojection %.2f px, "
-        "window residual median %.2f sigma, residual scale %.1f\n",
+        "  %-7s factors     %llu between factors (%llu from a keyframe) from %llu frames; gate %s "
+        "(left %llu, rejoined %llu times, %llu intervals gated out); %llu without frames, %llu "
+        "failed, %llu implausible; last omega %.2f, confidence %.2f, %d inliers, %d still "
+        "features left out, reprojection %.2f px, window residual median %.2f sigma, residual "
+        "scale %.1f\n",
         kStreams[i], static_cast<unsigned long long>(v.factors),
+        static_cast<unsigned long long>(v.keyframe_factors),
         static_cast<unsigned long long>(v.frames), v.active ? "open" : "closed",
         static_cast<unsigned long long>(v.left), static_cast<unsigned long long>(v.rejoined),
         static_cast<unsigned long long>(v.gated_out), static_cast<unsigned long long>(v.no_frames),
         static_cast<unsigned long long>(v.failed), static_cast<unsigned long long>(v.implausible),
-        v.omega, v.confidence, v.inliers, v.reprojection_rms_px, v.residual_median,
+        v.omega, v.confidence, v.inliers, v.still, v.reprojection_rms_px, v.residual_median,
         v.residual_scale);
   }
   const PoseSelectionFigures& s = f.selection;

@@ -68,20 +68,22 @@ struct CameraFigures {
 /// One camera stream in the back end (visible, thermal, fused: vision::FrontendMode order): how
 /// its frame-to-frame motions entered the window as between factors (seed 002).
 struct VisualStreamFigures {
-  bool configured = false;      ///< this stream feeds the estimate when its images are good enough
-  bool active = false;          ///< its quality gate is open now
-  double omega = 0;             ///< covariance scale of its last frame (1 without weighting) [-]
-  double confidence = 0;        ///< image-quality confidence of its last frame [0..1]
-  double gradient = 0;          ///< gradient metric g of its last frame [0..1]
-  std::uint64_t frames = 0;     ///< frames it received [1]
-  std::uint64_t factors = 0;    ///< between factors it added to the window [1]
-  std::uint64_t gated_out = 0;  ///< state intervals skipped while its gate was closed [1]
-  std::uint64_t no_frames = 0;  ///< intervals without a frame near both states [1]
-  std::uint64_t failed = 0;     ///< intervals whose motion could not be estimated [1]
-  std::uint64_t implausible = 0;   ///< motions refused: too far from the IMU's prediction [1]
-  std::uint64_t left = 0;          ///< times the gate closed (image quality fell) [1]
-  std::uint64_t rejoined = 0;      ///< times it opened again [1]
-  int inliers = 0;                 ///< observations kept in its last motion [1]
+  bool configured = false;    ///< this stream feeds the estimate when its images are good enough
+  bool active = false;        ///< its quality gate is open now
+  double omega = 0;           ///< covariance scale of its last frame (1 without weighting) [-]
+  double confidence = 0;      ///< image-quality confidence of its last frame [0..1]
+  double gradient = 0;        ///< gradient metric g of its last frame [0..1]
+  std::uint64_t frames = 0;   ///< frames it received [1]
+  std::uint64_t factors = 0;  ///< between factors it added to the window [1]
+  std::uint64_t keyframe_factors = 0;  ///< of which from a keyframe older than the newest state [1]
+  std::uint64_t gated_out = 0;         ///< state intervals skipped while its gate was closed [1]
+  std::uint64_t no_frames = 0;         ///< intervals without a frame near both states [1]
+  std::uint64_t failed = 0;            ///< intervals whose motion could not be estimated [1]
+  std::uint64_t implausible = 0;       ///< motions refused: too far from the IMU's prediction [1]
+  std::uint64_t left = 0;              ///< times the gate closed (image quality fell) [1]
+  std::uint64_t rejoined = 0;          ///< times it opened again [1]
+  int inliers = 0;                     ///< observations kept in its last motion [1]
+  int still = 0;  ///< observations of its last motion left out as not moving with the world [1]
   double reprojection_rms_px = 0;  ///< RMS reprojection error of its last motion [px]
   /// median whitened residual |r| of its factors in the window after the last solve [sigma]
   double residual_median = 0;

@@ -453,14 +453,18 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   if (aiding_ != nullptr) aiding_->relative_motions(window_, predicted, motions_);
   if (lidar_factor && !motions_.empty() && lidar_suspect_) reconcile(*lidar_factor);
   const imu::ImuState initial = initial_value(predicted, pre, match);
-  const std::uint64_t previous = window_.latest_id();
+  // The states the motions start from, by id: adding a state may marginalise the oldest.
+  from_ids_.clear();
+  for (const RelativeMotion& m : motions_) from_ids_.push_back(window_.id(m.from_index));
   window_.add(initial, pre, lidar_factor);
-  for (const RelativeMotion& m : motions_) {
+  for (std::size_t k = 0; k < motions_.size(); ++k) {
+    const RelativeMotion& m = motions_[k];
     std::unique_ptr<ceres::LossFunction> loss;
     if (m.huber_sigma > 0) loss = std::make_unique<ceres::HuberLoss>(m.huber_sigma);
     const bool added = window_.add_factor(
-        m.kind, std::make_unique<RelativePoseFactor>(m.T_i_j, m.information),
-        {{previous, BlockRole::kPose}, {window_.latest_id(), BlockRole::kPose}}, std::move(loss));
+        m.kind, std::make_unique<RelativePoseFactor>(m.T_k_j, m.information),
+        {{from_ids_[k], BlockRole::kPose}, {window_.latest_id(), BlockRole::kPose}},
+        std::move(loss));
     if (!added) continue;
     modalities |= m.kind == FactorKind::kVisible   ? kModalityVisible
                   : m.kind == FactorKind::kThermal ? kModalityThermal

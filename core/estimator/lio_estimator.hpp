@@ -192,6 +192,7 @@ class LioEstimator final : public FusionCore {
   LioStepProbe* probe_ = nullptr;
   WindowAiding* aiding_ = nullptr;
   std::vector<RelativeMotion> motions_;            // this scan's, from the aiding
+  std::vector<std::uint64_t> from_ids_;            // the window ids their motions start from
   std::optional<HostTime> last_degenerate_stamp_;  // of the last scan with a degenerate direction
   bool lidar_suspect_ = false;     // one was found within aided_suspect_window_s (reconcile())
   bool aided_degeneracy_ = false;  // the lidar's degeneracy is set for an active aiding

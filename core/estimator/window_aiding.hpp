@@ -14,11 +14,17 @@
 
 namespace posed::estimator {
 
-/// T_i_j = T_map_i⁻¹ T_map_j of base_link between the previous state i and the new state j.
+/// A motion of base_link ending at the new state j: T_k_j = T_map_k⁻¹ T_map_j from a state k of
+/// the window (the newest, i, for a consecutive pair; an older keyframe for a longer baseline).
 struct RelativeMotion {
   FactorKind kind = FactorKind::kVisible;
+  /// k: the window index (at the time of the call) of the state the motion starts from
+  std::size_t from_index = 0;
+  Eigen::Isometry3d T_k_j = Eigen::Isometry3d::Identity();
+  /// the same motion from the newest state i, through the window's current estimate of k to i
+  /// (T_i_j = T_map_i⁻¹ T_map_k T_k_j), for the checks that compare sensors over the interval
   Eigen::Isometry3d T_i_j = Eigen::Isometry3d::Identity();
-  /// (rotation, translation), right perturbation of T_i_j
+  /// (rotation, translation), right perturbation of T_k_j (and so of T_i_j)
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
   /// robust loss scale in whitened units (Huber); 0: plain least squares
   double huber_sigma = 0;
@@ -27,9 +33,9 @@ struct RelativeMotion {
 class WindowAiding {
  public:
   virtual ~WindowAiding() = default;
-  /// Appends the relative motions measured between the window's newest state (`window.latest()`,
-  /// optimised) and the state about to be added at `next.stamp`, whose pose `next` is its IMU
-  /// prediction. May append nothing.
+  /// Appends the relative motions measured between states of the window (optimised) and the
+  /// state about to be added at `next.stamp`, whose pose `next` is its IMU prediction. May
+  /// append nothing.
   virtual void relative_motions(const SlidingWindow& window, const imu::ImuState& next,
                                 std::vector<RelativeMotion>& out) = 0;
   /// Whether it expects to add motions for the next state (e.g. a camera whose images are good

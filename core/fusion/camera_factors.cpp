@@ -116,77 +116,110 @@ const CameraFactors::StoredFrame* CameraFactors::frame_before(const Stream& s, H
   return nullptr;
 }
 
+std::optional<estimator::RelativeMotion> CameraFactors::measure(
+    std::size_t stream, const estimator::SlidingWindow& window, std::size_t k,
+    const imu::ImuState& next, bool count_failure) {
+  VisualStreamFigures& f = figures_[stream];
+  const imu::ImuState before_k = window.state(k - 1);
+  const imu::ImuState at_k = window.state(k);
+  const imu::ImuState i = window.latest();
+  const StoredFrame* a = frame_before(streams_[stream], at_k.stamp);
+  const StoredFrame* b = frame_before(streams_[stream], next.stamp);
+  if (a == nullptr || b == nullptr || b->stamp <= a->stamp || a->stamp < before_k.stamp) {
+    f.no_frames += count_failure ? 1 : 0;
+    return std::nullopt;
+  }
+  // base_link at the two frames' stamps, from the window's motion around them.
+  const std::optional<Pose> at_a = interpolate_pose(pose(before_k), pose(at_k), a->stamp);
+  const std::optional<Pose> at_b = interpolate_pose(pose(i), pose(next), b->stamp);
+  if (!at_a || !at_b) {
+    f.no_frames += count_failure ? 1 : 0;
+    return std::nullopt;
+  }
+  const Eigen::Isometry3d T_map_a = isometry(*at_a), T_map_b = isometry(*at_b);
+  const Eigen::Isometry3d& T_imu_s = config_.T_imu_sensor[stream];
+  const Eigen::Isometry3d predicted_a_b = T_map_a.inverse() * T_map_b;  // base_link, a to b
+  FrameMotionConfig motion_config = config_.motion;
+  motion_config.gate_falls_back = stream == 0 || !config_.thermal_gate_strict;  // 0: visible
+  const FrameMotion m = estimate_frame_motion(
+      a->features, b->features, T_imu_s.inverse() * predicted_a_b * T_imu_s, motion_config);
+  if (!m.ok()) {
+    f.failed += count_failure ? 1 : 0;
+    return std::nullopt;
+  }
+  const Eigen::Isometry3d measured_a_b = T_imu_s * m.T_a_b * T_imu_s.inverse();
+  const Eigen::Isometry3d disagreement = predicted_a_b.inverse() * measured_a_b;
+  if (disagreement.translation().norm() > config_.max_disagreement_m ||
+      so3::log(Eigen::Matrix3d(disagreement.linear())).norm() > config_.max_disagreement_rad) {
+    f.implausible += count_failure ? 1 : 0;
+    return std::nullopt;
+  }
+  f.inliers = m.inliers;
+  f.still = m.still;
+  f.reprojection_rms_px = m.rms_sigma * config_.pixel_sigma_px;
+  // T_k_j = (T_k⁻¹ T_a) M (T_b⁻¹ T_j); the measurement's perturbation moves through the
+  // extrinsic and the bridge to state j (right perturbations: Ad of the inverse bridge).
+  const Eigen::Isometry3d bridge_b_j = T_map_b.inverse() * isometry(next);
+  estimator::RelativeMotion motion;
+  motion.kind = kKinds[stream];
+  motion.from_index = k;
+  motion.T_k_j = isometry(at_k).inverse() * T_map_a * measured_a_b * bridge_b_j;
+  motion.T_i_j = isometry(i).inverse() * isometry(at_k) * motion.T_k_j;
+  const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
+  const double omega = std::max(a->omega, b->omega) * residual_scale_[stream];
+  Mat6 covariance = omega * A * m.covariance * A.transpose();
+  covariance.diagonal().tail<3>().array() +=
+      config_.floor_translation_m * config_.floor_translation_m;
+  if (config_.translation_only) {
+    // The rotation was the window's: only the translation is the cameras' information.
+    motion.information.setZero();
+    motion.information.bottomRightCorner<3, 3>() =
+        covariance.bottomRightCorner<3, 3>().ldlt().solve(Eigen::Matrix3d::Identity());
+  } else {
+    covariance.diagonal().head<3>().array() +=
+        config_.floor_rotation_rad * config_.floor_rotation_rad;
+    motion.information = covariance.ldlt().solve(Mat6::Identity());
+  }
+  motion.information = 0.5 * (motion.information + motion.information.transpose());
+  motion.huber_sigma = config_.huber_sigma;
+  return motion;
+}
+
 void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
                                      const imu::ImuState& next,
                                      std::vector<estimator::RelativeMotion>& out) {
-  if (window.size() < 2) return;  // the frame before the newest state needs the one before it
-  const imu::ImuState h = window.state(window.size() - 2);
-  const imu::ImuState i = window.latest();
+  if (window.size() < 2) return;  // the frame before a state needs the state before it
+  const std::size_t newest = window.size() - 1;
   for (std::size_t stream = 0; stream < 3; ++stream) {
     if (!config_.streams[stream]) continue;
     VisualStreamFigures& f = figures_[stream];
+    std::optional<HostTime>& keyframe = keyframe_stamp_[stream];
     if (!f.active) {
       ++f.gated_out;
+      keyframe.reset();
       continue;
     }
-    const StoredFrame* a = frame_before(streams_[stream], i.stamp);
-    const StoredFrame* b = frame_before(streams_[stream], next.stamp);
-    if (a == nullptr || b == nullptr || b->stamp <= a->stamp || a->stamp < h.stamp) {
-      ++f.no_frames;
-      continue;
+    // The keyframe's index in the window, if it is still there with the state before it.
+    std::optional<std::size_t> k;
+    for (std::size_t idx = 1; keyframe && idx < newest; ++idx) {
+      if (window.state(idx).stamp == *keyframe) k = idx;
     }
-    // base_link at the two frames' stamps, from the window's motion around them.
-    const std::optional<Pose> at_a = interpolate_pose(pose(h), pose(i), a->stamp);
-    const std::optional<Pose> at_b = interpolate_pose(pose(i), pose(next), b->stamp);
-    if (!at_a || !at_b) {
-      ++f.no_frames;
-      continue;
+    std::optional<estimator::RelativeMotion> motion;
+    if (k) motion = measure(stream, window, *k, next, false);
+    if (!motion) {  // no keyframe, or too few of its features left: the newest state starts one
+      k = newest;
+      keyframe = window.state(newest).stamp;
+      motion = measure(stream, window, newest, next, true);
     }
-    const Eigen::Isometry3d T_map_a = isometry(*at_a), T_map_b = isometry(*at_b);
-    const Eigen::Isometry3d& T_imu_s = config_.T_imu_sensor[stream];
-    const Eigen::Isometry3d predicted_a_b = T_map_a.inverse() * T_map_b;  // base_link, a to b
-    FrameMotionConfig motion_config = config_.motion;
-    motion_config.gate_falls_back = stream == 0 || !config_.thermal_gate_strict;  // 0: visible
-    const FrameMotion m = estimate_frame_motion(
-        a->features, b->features, T_imu_s.inverse() * predicted_a_b * T_imu_s, motion_config);
-    if (!m.ok()) {
-      ++f.failed;
-      continue;
+    if (motion) {
+      out.push_back(*motion);
+      ++f.factors;
+      if (*k < newest) ++f.keyframe_factors;
     }
-    f.inliers = m.inliers;
-    f.reprojection_rms_px = m.rms_sigma * config_.pixel_sigma_px;
-    const Eigen::Isometry3d measured_a_b = T_imu_s * m.T_a_b * T_imu_s.inverse();
-    const Eigen::Isometry3d disagreement = predicted_a_b.inverse() * measured_a_b;
-    if (disagreement.translation().norm() > config_.max_disagreement_m ||
-        so3::log(Eigen::Matrix3d(disagreement.linear())).norm() > config_.max_disagreement_rad) {
-      ++f.implausible;
-      continue;
+    // The new state anchors the next motions once this keyframe is keyframe_states old.
+    if (newest + 1 - *k >= static_cast<std::size_t>(std::max(config_.keyframe_states, 1))) {
+      keyframe = next.stamp;
     }
-    // T_i_j = (T_i⁻¹ T_a) M (T_b⁻¹ T_j); the measurement's perturbation moves through the
-    // extrinsic and the bridge to state j (right perturbations: Ad of the inverse bridge).
-    const Eigen::Isometry3d bridge_b_j = T_map_b.inverse() * isometry(next);
-    estimator::RelativeMotion motion;
-    motion.kind = kKinds[stream];
-    motion.T_i_j = isometry(i).inverse() * T_map_a * measured_a_b * bridge_b_j;
-    const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
-    const double omega = std::max(a->omega, b->omega) * residual_scale_[stream];
-    Mat6 covariance = omega * A * m.covariance * A.transpose();
-    covariance.diagonal().tail<3>().array() +=
-        config_.floor_translation_m * config_.floor_translation_m;
-    if (config_.translation_only) {
-      // The rotation was the window's: only the translation is the cameras' information.
-      motion.information.setZero();
-      motion.information.bottomRightCorner<3, 3>() =
-          covariance.bottomRightCorner<3, 3>().ldlt().solve(Eigen::Matrix3d::Identity());
-    } else {
-      covariance.diagonal().head<3>().array() +=
-          config_.floor_rotation_rad * config_.floor_rotation_rad;
-      motion.information = covariance.ldlt().solve(Mat6::Identity());
-    }
-    motion.information = 0.5 * (motion.information + motion.information.transpose());
-    motion.huber_sigma = config_.huber_sigma;
-    out.push_back(motion);
-    ++f.factors;
   }
 }
 

@@ -79,6 +79,21 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
   Mat6 H = Mat6::Zero();
   Eigen::Vector2d r;
   Mat26 J;
+  // Observations that hold still where the guess moves them (still_flow_sigma).
+  std::vector<std::uint8_t> still(obs.size(), 0);
+  if (config.still_flow_sigma > 0) {
+    const double min_flow = config.still_flow_sigma * config.pixel_sigma;
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+      if (!residual(obs[k], R, p, config.min_depth_m, r, J)) continue;
+      // Where the feature was in the frame that gave its depth, and how far the guess moves it.
+      const Eigen::Vector2d before = obs[k].X.head<2>() / obs[k].X.z();
+      const Eigen::Vector2d predicted = r + obs[k].u;
+      if ((predicted - before).norm() > min_flow && (obs[k].u - before).norm() < r.norm()) {
+        still[k] = 1;
+        ++out.still;
+      }
+    }
+  }
   if (config.guess_gate > 0) {
     int kept = 0;
     for (std::size_t k = 0; k < obs.size(); ++k) {
@@ -91,6 +106,9 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
       return out;
     }
     if (few && config.gate_falls_back) std::fill(inlier.begin(), inlier.end(), std::uint8_t{1});
+  }
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    if (still[k] != 0) inlier[k] = 0;
   }
   for (int round = 0; round < 2; ++round) {
     for (int it = 0; it < config.iterations; ++it) {

@@ -343,6 +343,12 @@ const Field kSchema[] = {
       1, "", "1-sigma added to each camera factor's translation (features are not independent)"),
     F("estimator.camera_floor_rotation_deg", estimator.camera_floor_rotation_deg, "0.06", "deg", 0,
       10, "", "1-sigma added to each camera factor's rotation"),
+    F("estimator.camera_keyframe_states", estimator.camera_keyframe_states, "5", "", 1, 49, "",
+      "a camera motion starts from a keyframe state and ends at each new state, for this many "
+      "states (at most window_size - 1); 1: from the previous state only"),
+    F("estimator.camera_still_flow_sigma", estimator.camera_still_flow_sigma, "2", "", 0, 100, "",
+      "a feature nearer to where it was than to where the predicted motion moves it, by more than "
+      "this many pixel sigmas, is left out (a corner of the lamp's shading or lens dirt); 0: off"),
     F("estimator.camera_degeneracy_translation_threshold",
       estimator.camera_degeneracy_translation_threshold, "10", "", 0, 10000, "",
       "while a camera stream is in the estimate, a scan is degenerate along translations it pins "
@@ -407,8 +413,10 @@ const Field kSchema[] = {
       "point features kept per frame (seed 001: 200-400)"),
     F("frontend.min_feature_distance_px", frontend.min_feature_distance_px, "20", "px", 2, 200, "",
       "least distance between features"),
-    F("frontend.ransac_threshold_px", frontend.ransac_threshold_px, "1", "px", 0.1, 10, "",
-      "distance to the epipolar line beyond which a track is an outlier"),
+    F("frontend.ransac_threshold_px", frontend.ransac_threshold_px, "4", "px", 0.1, 10, "",
+      "distance to the epipolar line beyond which a track is an outlier (the back end checks "
+      "the survivors against the IMU's motion; a tight threshold on a forward-moving camera "
+      "drops half of the good tracks)"),
     F("frontend.lines", frontend.lines, "false", "", 0, 0, "",
       "also track LSD line features (seed 001); several ms per frame"),
     F("frontend.depth_window_s", frontend.depth_window_s, "1", "s", 0, 10, "",

@@ -170,7 +170,7 @@ struct FrontendSection {
   double fusion_denoise_target_sigma = 2.0;  ///< [grey]
   int max_features = 300;
   double min_feature_distance_px = 20;  ///< [px]
-  double ransac_threshold_px = 1;       ///< [px]
+  double ransac_threshold_px = 4;       ///< [px]
   bool lines = false;
   double depth_window_s = 1;  ///< [s]
   int depth_points_per_scan = 20000;
@@ -210,6 +210,8 @@ struct EstimatorSection {
   double camera_rejoin_gradient = 0.04;       ///< [0..1]
   double camera_floor_translation_m = 0.002;  ///< 1-sigma floor per factor [m]
   double camera_floor_rotation_deg = 0.06;    ///< 1-sigma floor per factor [deg]
+  int camera_keyframe_states = 5;             ///< states a keyframe anchors motions for [1]
+  double camera_still_flow_sigma = 2;         ///< features that hold still are left out [sigma]
   bool pose_selection = true;                 ///< seed 001's adaptive initial value
   double camera_degeneracy_translation_threshold = 10;  ///< with cameras in the estimate [1]
   double camera_degenerate_information_scale = 0;       ///< with cameras in the estimate [-]

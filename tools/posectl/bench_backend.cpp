@@ -137,13 +137,15 @@ int bench_backend() {
     auto t0 = Clock::now();
     factors.relative_motions(with, state_at(t), motions);
     motion_ms.push_back(ms_since(t0));
-    const std::uint64_t previous = with.latest_id();
+    std::vector<std::uint64_t> from_ids;
+    for (const auto& m : motions) from_ids.push_back(with.id(m.from_index));
     with.add(state_at(t), pre, lidar);
     without.add(state_at(t), pre, lidar);
-    for (const auto& m : motions) {
+    for (std::size_t j = 0; j < motions.size(); ++j) {
+      const auto& m = motions[j];
       with.add_factor(m.kind,
-                      std::make_unique<estimator::RelativePoseFactor>(m.T_i_j, m.information),
-                      {{previous, estimator::BlockRole::kPose},
+                      std::make_unique<estimator::RelativePoseFactor>(m.T_k_j, m.information),
+                      {{from_ids[j], estimator::BlockRole::kPose},
                        {with.latest_id(), estimator::BlockRole::kPose}},
                       std::make_unique<ceres::HuberLoss>(m.huber_sigma));
     }

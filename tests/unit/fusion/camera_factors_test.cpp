@@ -111,6 +111,35 @@ TEST(CameraFactors, MeasuresTheMotionBetweenStatesFromFramesOffTheirStamps) {
   EXPECT_EQ(factors.figures()[0].factors, 1u);
 }
 
+TEST(CameraFactors, MotionsStartFromAKeyframeForKeyframeStates) {
+  const FactorsWorld world;
+  CameraFactorsConfig config = factors_config();
+  config.keyframe_states = 3;
+  CameraFactors factors(config);
+  for (double t = 0.013; t < 1.0; t += 1.0 / 15)
+    factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  fill(window, 0.3);
+  imu::Preintegration pre(imu::ImuNoise{1e-3, 1e-2, 1e-5, 1e-4}, imu::ImuBias{}, HostTime{});
+  // The state at 0.3 s anchors the next three (0.4, 0.5, 0.6 s); then 0.6 s starts a keyframe.
+  const double next_s[] = {0.4, 0.5, 0.6, 0.7};
+  const double from_s[] = {0.3, 0.3, 0.3, 0.6};
+  for (int k = 0; k < 4; ++k) {
+    std::vector<estimator::RelativeMotion> motions;
+    factors.relative_motions(window, state_at(next_s[k]), motions);
+    ASSERT_EQ(motions.size(), 1u) << next_s[k];
+    const estimator::RelativeMotion& m = motions[0];
+    EXPECT_NEAR(window.state(m.from_index).stamp.seconds(), from_s[k], 1e-6) << next_s[k];
+    const Eigen::Isometry3d T_k_j = truth(from_s[k]).inverse() * truth(next_s[k]);
+    const Eigen::Isometry3d T_i_j = truth(next_s[k] - 0.1).inverse() * truth(next_s[k]);
+    EXPECT_LT((m.T_k_j.translation() - T_k_j.translation()).norm(), 2e-3) << next_s[k];
+    EXPECT_LT((m.T_i_j.translation() - T_i_j.translation()).norm(), 2e-3) << next_s[k];
+    window.add(state_at(next_s[k]), pre, std::nullopt);
+  }
+  EXPECT_EQ(factors.figures()[0].factors, 4u);
+  EXPECT_EQ(factors.figures()[0].keyframe_factors, 2u);
+}
+
 TEST(CameraFactors, APredictionTooSlowIsCorrectedOverTheFramesSpan) {
   // The window's prediction for the state at 0.4 s has the robot 30 % too slow since 0.3 s (a
   // degenerate corridor's drift). The frames measure the motion between their stamps; only the

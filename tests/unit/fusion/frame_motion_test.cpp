@@ -87,6 +87,36 @@ TEST(FrameMotion, DropsFeaturesWithAWrongDepth) {
   EXPECT_GT((all.T_a_b.translation() - T.translation()).norm(), 1.5 * error_m);
 }
 
+TEST(FrameMotion, LeavesOutFeaturesThatHoldStillInTheImage) {
+  // A third of the features are corners of the shading the robot's own lamp casts on a plain
+  // wall: the same pixel in both frames, with the wall's depth. The guess is the window's, 20 %
+  // short, as it is where the lidar cannot see the motion.
+  std::mt19937 rng(5);
+  const Eigen::Isometry3d T = forward_motion();
+  Frames f = make_frames(T, 100, 0.3, rng);
+  std::uniform_real_distribution<double> where(-0.4, 0.4);
+  for (int k = 0; k < 50; ++k) {
+    const auto id = static_cast<std::uint64_t>(1000 + k);
+    const Eigen::Vector2d at(where(rng), where(rng));
+    f.a.push_back({id, at, 1.5});
+    f.b.push_back({id, at, 1.5});
+  }
+  Eigen::Isometry3d guess = T;
+  guess.translation() *= 0.8;
+  const FrameMotion with = estimate_frame_motion(f.a, f.b, guess, config());
+  FrameMotionConfig off = config();
+  off.still_flow_sigma = 0;
+  const FrameMotion without = estimate_frame_motion(f.a, f.b, guess, off);
+  ASSERT_TRUE(with.ok());
+  ASSERT_TRUE(without.ok());
+  // Of their 100 observations nearly all; of the world's 200 a few near the focus of expansion.
+  EXPECT_GE(with.still, 90);
+  EXPECT_LE(with.still, 110);
+  EXPECT_LT((with.T_a_b.translation() - T.translation()).norm(), 0.004);
+  EXPECT_EQ(without.still, 0);
+  EXPECT_GT((without.T_a_b.translation() - T.translation()).norm(), 0.01);
+}
+
 TEST(FrameMotion, CovarianceMatchesTheSpreadOfEstimates) {
   const Eigen::Isometry3d T = forward_motion();
   std::mt19937 rng(5);
@@ -144,6 +174,7 @@ TEST(FrameMotion, AStrictGateIgnoresAStillMajority) {
   const Frames f = with_fixed_pattern(T, 40, 100, rng);
   FrameMotionConfig c = config();
   c.guess_gate = 3.0 / kFocalPx;
+  c.still_flow_sigma = 0;  // the gate alone (the still test is LeavesOutFeaturesThatHoldStill)
   // The guess (the IMU's) is right: the moving minority passes the gate, the still majority not.
   c.gate_falls_back = false;
   const FrameMotion strict = estimate_frame_motion(f.a, f.b, T, c);
@@ -154,6 +185,11 @@ TEST(FrameMotion, AStrictGateIgnoresAStillMajority) {
   const FrameMotion lenient = estimate_frame_motion(f.a, f.b, T, c);
   ASSERT_TRUE(lenient.ok());
   EXPECT_GT((lenient.T_a_b.translation() - T.translation()).norm(), 0.05);
+  // Unless the features that hold still where the guess moves them are left out first.
+  c.still_flow_sigma = 2.0;
+  const FrameMotion with_still_test = estimate_frame_motion(f.a, f.b, T, c);
+  ASSERT_TRUE(with_still_test.ok());
+  EXPECT_LT((with_still_test.T_a_b.translation() - T.translation()).norm(), 0.004);
 }
 
 TEST(FrameMotion, AStrictGateWithTooFewInsideGivesNothing) {
