@@ -94,6 +94,12 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
       }
     }
   }
+  if (2 * out.still > static_cast<int>(obs.size())) {
+    // Most of the features hold still where the guess moves them: the guess is what is wrong (a
+    // speed gone twice the truth), and leaving them out would keep it wrong.
+    std::fill(still.begin(), still.end(), std::uint8_t{0});
+    out.still = 0;
+  }
   if (config.guess_gate > 0) {
     int kept = 0;
     for (std::size_t k = 0; k < obs.size(); ++k) {

@@ -58,7 +58,8 @@ struct FrameMotionConfig {
   /// share (the simulated corridor: a quarter of the features with depth), the Huber kernel and
   /// the outlier round cannot outvote them, and the motion came out 13-17 % short on average.
   /// A guess from the IMU and the window is far better than the half of the flow this test
-  /// needs, so a feature of the world passes it.
+  /// needs, so a feature of the world passes it; if most observations fail it, the guess is what
+  /// is wrong (a speed estimate twice the truth) and none is left out.
   double still_flow_sigma = 2.0;
 };
 
