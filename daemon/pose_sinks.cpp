@@ -178,7 +178,9 @@ void PoseSinks::status(const pipeline::PipelineStatus& st) {
                      v.rejoined,
                      v.inliers,
                      v.reprojection_rms_px,
-                     v.residual_median};
+                     v.residual_median,
+                     v.keyframe_factors,
+                     v.still};
   }
   msg.selection = {f.selection.lidar_visual_inertial, f.selection.lidar_inertial,
                    f.selection.visual_inertial, f.selection.imu_only, f.selection.last_threshold_m};

@@ -450,7 +450,10 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
     modalities |= kModalityLidar;
   }
   motions_.clear();
-  if (aiding_ != nullptr) aiding_->relative_motions(window_, predicted, motions_);
+  if (aiding_ != nullptr) {
+    aiding_->set_lidar_weak(lidar_suspect_);
+    aiding_->relative_motions(window_, predicted, motions_);
+  }
   if (lidar_factor && !motions_.empty() && lidar_suspect_) reconcile(*lidar_factor);
   const imu::ImuState initial = initial_value(predicted, pre, match);
   // The states the motions start from, by id: adding a state may marginalise the oldest.

@@ -38,6 +38,9 @@ class WindowAiding {
   /// append nothing.
   virtual void relative_motions(const SlidingWindow& window, const imu::ImuState& next,
                                 std::vector<RelativeMotion>& out) = 0;
+  /// Told before each relative_motions whether the lidar has recently been unable to pin a
+  /// direction (a scan with a degenerate direction within `aided_suspect_window_s`).
+  virtual void set_lidar_weak(bool weak) { (void)weak; }
   /// Whether it expects to add motions for the next state (e.g. a camera whose images are good
   /// enough): the lidar then leaves its weakly constrained directions to it.
   virtual bool active() const = 0;

@@ -205,7 +205,7 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
       if (window.state(idx).stamp == *keyframe) k = idx;
     }
     std::optional<estimator::RelativeMotion> motion;
-    if (k) motion = measure(stream, window, *k, next, false);
+    if (k && lidar_weak_) motion = measure(stream, window, *k, next, false);
     if (!motion) {  // no keyframe, or too few of its features left: the newest state starts one
       k = newest;
       keyframe = window.state(newest).stamp;
@@ -217,7 +217,8 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
       if (*k < newest) ++f.keyframe_factors;
     }
     // The new state anchors the next motions once this keyframe is keyframe_states old.
-    if (newest + 1 - *k >= static_cast<std::size_t>(std::max(config_.keyframe_states, 1))) {
+    if (!lidar_weak_ ||
+        newest + 1 - *k >= static_cast<std::size_t>(std::max(config_.keyframe_states, 1))) {
       keyframe = next.stamp;
     }
   }

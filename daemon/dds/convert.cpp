@@ -100,6 +100,8 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
     d.inliers = v.inliers;
     d.reprojection_rms_px = v.reprojection_rms_px;
     d.residual_median = v.residual_median;
+    d.keyframe_factors = v.keyframe_factors;
+    d.still = v.still;
   }
   out.selection.lidar_visual_inertial = msg.selection.lidar_visual_inertial;
   out.selection.lidar_inertial = msg.selection.lidar_inertial;
@@ -380,6 +382,8 @@ StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
     d.inliers = v.inliers;
     d.reprojection_rms_px = v.reprojection_rms_px;
     d.residual_median = v.residual_median;
+    d.keyframe_factors = v.keyframe_factors;
+    d.still = v.still;
   }
   msg.selection.lidar_visual_inertial = in.selection.lidar_visual_inertial;
   msg.selection.lidar_inertial = in.selection.lidar_inertial;

@@ -284,17 +284,19 @@ struct CameraStatusMessage {
 /// posed_msgs/VisualStreamStatus: one camera stream in the estimate.
 struct VisualStreamStatusMessage {
   bool configured = false;
-  bool active = false;             ///< gate open
-  double omega = 0;                ///< [-]
-  double confidence = 0;           ///< [0..1]
-  std::uint64_t factors = 0;       ///< [count]
-  std::uint64_t failed = 0;        ///< [count]
-  std::uint64_t gated_out = 0;     ///< [count]
-  std::uint64_t left = 0;          ///< [count]
-  std::uint64_t rejoined = 0;      ///< [count]
-  std::int32_t inliers = 0;        ///< [count]
-  double reprojection_rms_px = 0;  ///< [px]
-  double residual_median = 0;      ///< [sigma]
+  bool active = false;                 ///< gate open
+  double omega = 0;                    ///< [-]
+  double confidence = 0;               ///< [0..1]
+  std::uint64_t factors = 0;           ///< [count]
+  std::uint64_t failed = 0;            ///< [count]
+  std::uint64_t gated_out = 0;         ///< [count]
+  std::uint64_t left = 0;              ///< [count]
+  std::uint64_t rejoined = 0;          ///< [count]
+  std::int32_t inliers = 0;            ///< [count]
+  double reprojection_rms_px = 0;      ///< [px]
+  double residual_median = 0;          ///< [sigma]
+  std::uint64_t keyframe_factors = 0;  ///< [count]
+  std::int32_t still = 0;              ///< [count]
 };
 
 /// posed_msgs/PoseSelectionStatus: seed 001's choices of initial value.

@@ -207,7 +207,9 @@ std::string_view posed_status_schema() {
             "uint64 rejoined\n"
             "int32 inliers\n"
             "float64 reprojection_rms_px\n"
-            "float64 residual_median\n",
+            "float64 residual_median\n"
+            "uint64 keyframe_factors\n"
+            "int32 still\n",
             "MSG: posed_msgs/PoseSelectionStatus\n"
             "uint64 lidar_visual_inertial\n"
             "uint64 lidar_inertial\n"

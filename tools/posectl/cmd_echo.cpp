@@ -383,12 +383,14 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
     any_visual = true;
     std::printf(
         "  %-10s %s  omega %.2f confidence %.2f  factors %llu failed %llu gated out %llu (left "
-        "%llu, rejoined %llu)  last %d inliers %.2f px  window residual median %.2f sigma\n",
+        "%llu, rejoined %llu), %llu from a keyframe  last %d inliers (%d still left out) %.2f px  "
+        "window residual median %.2f sigma\n",
         kVisual[i], v.active ? "in the estimate" : "gated out", v.omega, v.confidence,
         static_cast<unsigned long long>(v.factors), static_cast<unsigned long long>(v.failed),
         static_cast<unsigned long long>(v.gated_out), static_cast<unsigned long long>(v.left),
-        static_cast<unsigned long long>(v.rejoined), v.inliers, v.reprojection_rms_px,
-        v.residual_median);
+        static_cast<unsigned long long>(v.rejoined),
+        static_cast<unsigned long long>(v.keyframe_factors), v.inliers, v.still,
+        v.reprojection_rms_px, v.residual_median);
   }
   const dds::PoseSelectionStatusMessage& sel = m.selection;
   if (sel.lidar_visual_inertial + sel.lidar_inertial + sel.visual_inertial + sel.imu_only > 0) {

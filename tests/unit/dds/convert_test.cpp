@@ -95,6 +95,11 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   msg.camera.omega = {90.0, 2.0, 1.5};
   msg.uptime_s = 12.5;
   msg.summary = "ok";
+  msg.visual[0].configured = true;
+  msg.visual[0].factors = 40;
+  msg.visual[0].keyframe_factors = 31;
+  msg.visual[0].still = 7;
+  msg.visual[0].residual_median = 1.5;
   for (const char* name : {"imu", "lidar", "color"}) {
     StreamStatusMessage s;
     s.name = name;
@@ -128,6 +133,11 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   EXPECT_EQ(back.estimator.scans_degenerate, 56u);
   EXPECT_EQ(back.estimator.reinitialisations, 2u);
   EXPECT_EQ(back.estimator.degenerate_directions, 1);
+  EXPECT_TRUE(back.visual[0].configured);
+  EXPECT_EQ(back.visual[0].factors, 40u);
+  EXPECT_EQ(back.visual[0].keyframe_factors, 31u);
+  EXPECT_EQ(back.visual[0].still, 7);
+  EXPECT_EQ(back.visual[0].residual_median, 1.5);
   EXPECT_EQ(back.estimator.gyro_bias_radps, msg.estimator.gyro_bias_radps);
   EXPECT_EQ(back.estimator.accel_bias_mps2, msg.estimator.accel_bias_mps2);
   EXPECT_EQ(back.camera.mode, "fused");

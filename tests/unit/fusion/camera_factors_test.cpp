@@ -138,6 +138,14 @@ TEST(CameraFactors, MotionsStartFromAKeyframeForKeyframeStates) {
   }
   EXPECT_EQ(factors.figures()[0].factors, 4u);
   EXPECT_EQ(factors.figures()[0].keyframe_factors, 2u);
+  // The keyframe at 0.6 s would anchor 0.8 s too; where the lidar pins every direction the
+  // motion starts from the previous state instead.
+  factors.set_lidar_weak(false);
+  std::vector<estimator::RelativeMotion> motions;
+  factors.relative_motions(window, state_at(0.8), motions);
+  ASSERT_EQ(motions.size(), 1u);
+  EXPECT_NEAR(window.state(motions[0].from_index).stamp.seconds(), 0.7, 1e-6);
+  EXPECT_EQ(factors.figures()[0].keyframe_factors, 2u);
 }
 
 TEST(CameraFactors, APredictionTooSlowIsCorrectedOverTheFramesSpan) {
