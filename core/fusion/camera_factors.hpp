@@ -11,14 +11,17 @@
 // state carries it; the window stays at 15 coordinates per state and its cost per scan grows by
 // microseconds, where hundreds of reprojection factors and landmark blocks would cost tens of
 // milliseconds on a 2-core robot. The price: a feature seen over many states constrains each
-// consecutive pair, not the whole span at once. Seed 002 makes the same choice for visible and
-// thermal odometry; seed 001's point residuals are the tightly coupled alternative.
+// pair of states, not the whole span at once (keyframes lengthen the pairs). Seed 002 makes the
+// same choice for visible and thermal odometry; seed 001's point residuals are the tightly
+// coupled alternative.
 //
 // Timing. States sit at scan ends (10 Hz), frames at 15 Hz (visible) or the visible events
-// (thermal mode runs on them too). For states i and j the factor uses the last frame at or before
-// each state's stamp; the short intervals between a frame and its state are bridged with the
-// window's own motion, interpolated between the neighbouring states (linear in position, SLERP
-// in rotation: seed 002's interpolation), which over tens of milliseconds is good to a millimetre.
+// (thermal mode runs on them too). A factor ties the new state j to a state k of the window: the
+// previous state, or where the lidar is weak a keyframe a few states back (keyframe_states). It
+// uses the last frame at or before each state's stamp; the short intervals between a frame and
+// its state are bridged with the window's own motion, interpolated between the neighbouring
+// states (linear in position, SLERP in rotation: seed 002's interpolation), which over tens of
+// milliseconds is good to a millimetre.
 // Frames' stamps are ClockSync's (the D435i's hardware clock; the thermal camera's arrival minus
 // its configured latency). The camera-IMU extrinsic comes from the configuration.
 //

@@ -101,10 +101,11 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
   const double with_camera = ate_m(a.poses, truth), lidar_only = ate_m(lio.poses, truth);
   std::printf("tunnel seed 4, 30 s: ATE %.3f m with the visible camera, %.3f m lidar-inertial\n",
               with_camera, lidar_only);
-  // Measured when written: 0.49 m against 4.96 m. The camera must at least quarter the error and
-  // keep it under a metre in 30 s, which the lidar alone cannot.
-  EXPECT_LT(with_camera, 1.0);
-  EXPECT_LT(with_camera, lidar_only / 4);
+  // Measured when written: 0.49 m against 4.96 m; 0.115 m since features that hold still are
+  // left out (stop 28). The camera must cut the error tenfold and keep it under 0.3 m in 30 s,
+  // which the lidar alone cannot.
+  EXPECT_LT(with_camera, 0.3);
+  EXPECT_LT(with_camera, lidar_only / 10);
   EXPECT_GT(lidar_only, 1.0);
 }
 
