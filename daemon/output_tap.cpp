@@ -43,7 +43,7 @@ OutputTap::OutputTap(drivers::recording::Recorder* recorder,
     for (dds::Topic t : served_topics) {
       const std::string_view type = dds::ros_type_name(t);
       // Transient-local on DDS, latched here: Studio connects whenever its user does.
-      const bool latched = t == dds::Topic::kTfStatic || t == dds::Topic::kMap;
+      const bool latched = dds::transient_local(t);
       foxglove_channel_[static_cast<std::size_t>(t)] = foxglove_->add_channel(
           {std::string(dds::ros_topic_name(t)), std::string(ros2::kMessageEncoding),
            std::string(type), std::string(ros2::kSchemaEncoding),
@@ -53,19 +53,17 @@ OutputTap::OutputTap(drivers::recording::Recorder* recorder,
   if (recorder_ == nullptr) return;
   for (dds::Topic t : record_topics) {
     if (t == dds::Topic::kOdom || t == dds::Topic::kPose) continue;
-    const bool large = t == dds::Topic::kCloud || t == dds::Topic::kMap || t == dds::Topic::kImage;
     // ~1.2 MB a scan: 64 queued bound what a stalled disk costs to ~80 MB.
-    record_channel_[static_cast<std::size_t>(t)] =
-        recorder_->add_ros2_channel(dds::ros_topic_name(t), dds::ros_type_name(t), large ? 64 : 0);
+    record_channel_[static_cast<std::size_t>(t)] = recorder_->add_ros2_channel(
+        dds::ros_topic_name(t), dds::ros_type_name(t), dds::large_messages(t) ? 64 : 0);
   }
 }
 
 bool OutputTap::wants(dds::Topic topic) const {
   const auto i = static_cast<std::size_t>(topic);
-  const bool latched = topic == dds::Topic::kTfStatic || topic == dds::Topic::kMap;
   return record_channel_[i] != kNone ||
          (foxglove_channel_[i] != 0 &&
-          (latched || foxglove_->has_subscribers(foxglove_channel_[i])));
+          (dds::transient_local(topic) || foxglove_->has_subscribers(foxglove_channel_[i])));
 }
 
 void OutputTap::deliver(dds::Topic topic, WallTime stamp, std::span<const std::byte> cdr) {

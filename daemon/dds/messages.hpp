@@ -29,6 +29,15 @@ enum class Topic {
   kMap,
   kImage
 };
+/// Topics whose newest message a reader that joins later still gets: transient-local on DDS
+/// (tf2's static broadcaster QoS; the map as map servers publish it), latched on Foxglove.
+constexpr bool transient_local(Topic topic) {
+  return topic == Topic::kTfStatic || topic == Topic::kMap;
+}
+/// Topics whose messages are large (point clouds, images): few are queued.
+constexpr bool large_messages(Topic topic) {
+  return topic == Topic::kCloud || topic == Topic::kMap || topic == Topic::kImage;
+}
 inline constexpr std::array kAllTopics = {
     Topic::kOdom, Topic::kPose,        Topic::kStatus, Topic::kTf,  Topic::kTfStatic,
     Topic::kPath, Topic::kDiagnostics, Topic::kCloud,  Topic::kMap, Topic::kImage};

@@ -195,13 +195,13 @@ dds_qos_t* make_topic_qos(Topic topic) {
   // A reliable writer whose readers' buffers are full waits at most this long in dds_write,
   // so a stalled subscriber costs the publishing thread a bounded time, never a hang.
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(10));
-  if (topic == Topic::kTfStatic || topic == Topic::kMap) {
+  if (transient_local(topic)) {
     // tf2_ros::StaticBroadcasterQoS: transient-local, and the one latest message holds every
     // static transform (a static broadcaster resends them all when one changes). The map is
     // published as map servers do: the latest one reaches a reader that joins later.
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  } else if (topic == Topic::kCloud || topic == Topic::kImage) {
+  } else if (large_messages(topic)) {
     // A scan is ~1.2 MB, an image ~50 kB: two held per reader bound the memory a slow reader
     // costs; an older one is worth nothing once a newer one exists.
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
