@@ -1,6 +1,6 @@
 #pragma once
-// What the recording and hardware-in-the-loop tests share: a DDS domain of their own and free
-// UDP ports for a live posed to listen on.
+// What the recording, hardware-in-the-loop and ROS 2 tool tests share: a DDS domain of their own
+// and free UDP and TCP ports for a live posed to listen on.
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -16,9 +16,10 @@ namespace posed::testing::hil_helpers {
 // and replay (+50) tests of a process with the same id.
 inline int test_domain() { return 1 + static_cast<int>((::getpid() + 75) % 99); }
 
-/// A UDP port nobody uses right now (the kernel's pick of an ephemeral port, released again).
-inline std::uint16_t free_udp_port() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+/// A port of `type` (SOCK_DGRAM, SOCK_STREAM) nobody uses on loopback right now (the kernel's
+/// pick of an ephemeral port, released again).
+inline std::uint16_t free_port(int type) {
+  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
@@ -28,6 +29,8 @@ inline std::uint16_t free_udp_port() {
   ::close(fd);
   return ntohs(a.sin_port);
 }
+inline std::uint16_t free_udp_port() { return free_port(SOCK_DGRAM); }
+inline std::uint16_t free_tcp_port() { return free_port(SOCK_STREAM); }
 
 /// The DDS and sensor part of a live posed's config: loopback DDS on the test's domain.
 inline std::string dds_config(const std::string& source_dir) {

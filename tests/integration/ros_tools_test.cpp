@@ -5,10 +5,7 @@
 // Foxglove's own npm client (tests/node) receives every topic over posed's Foxglove WebSocket
 // server and decodes every message with Foxglove's ros2msg parser and CDR reader.
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -201,19 +198,6 @@ TEST(Ros2Tools, RecordOutputsPutsTheTopicsInTheRecordingWithTheirSchemas) {
             count["/posed/pose geometry_msgs/msg/PoseStamped"]);
 }
 
-/// A TCP port nobody listens on right now (the kernel's pick, released again).
-std::uint16_t free_tcp_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 /// `name` on PATH, or "" (PosedProcess execs a path).
 std::string on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -252,7 +236,7 @@ TEST(Ros2Tools, FoxglovesOwnClientGetsAndDecodesEveryTopic) {
   ASSERT_TRUE(std::filesystem::exists(source_dir() + "/tests/node/node_modules/@foxglove"))
       << "the npm modules of tests/node are missing: run tools/install-deps";
   TempDir posed_dir, client_dir;
-  const std::uint16_t port = free_tcp_port();
+  const std::uint16_t port = hil_helpers::free_tcp_port();
   const std::string config = posed_dir.write(
       "posed.yaml",
       dds_yaml() + "foxglove:\n  enabled: true\n  port: " + std::to_string(port) +
