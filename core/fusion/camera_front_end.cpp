@@ -125,7 +125,10 @@ void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps)
     last_thermal_hash_ = hash;
     if (frozen) {
       e.thermal.reset();
-      for (Run& run : runs_) ++run.figures.thermal_frozen;
+      for (Run& run : runs_) {
+        ++run.figures.thermal_frozen;
+        run.frontend->thermal_shutter();
+      }
     }
   }
   vision::FrontendInput input =

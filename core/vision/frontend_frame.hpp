@@ -13,6 +13,7 @@
 #include "core/vision/depth_associator.hpp"
 #include "core/vision/image_quality.hpp"
 #include "core/vision/line_tracker.hpp"
+#include "core/vision/scene_nuc.hpp"
 #include "core/vision/thermal_aligner.hpp"
 
 namespace posed::vision {
@@ -86,6 +87,7 @@ struct FrontendFrame {
   StreamQualities quality;
   FrontendCounts counts;
   AlignStats thermal_alignment;  ///< how the thermal frame was registered (when used)
+  SceneNucStats thermal_nuc;     ///< what the scene-based NUC did (when enabled)
   double visible_gamma = 1;      ///< adaptive gamma applied to the visible image [-]
 };
 

@@ -59,6 +59,7 @@ VisualFrontend::VisualFrontend(const FrontendConfig& config)
     : config_(checked(config)),
       visible_enhancer_(config.visible_enhance),
       thermal_enhancer_(config.thermal_enhance),
+      thermal_nuc_(config.thermal_nuc),
       fusion_(config.fusion),
       quality_(config.quality),
       tracker_(config.tracker, config.visible_camera),
@@ -94,6 +95,7 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
   out.quality = {};
   out.counts = {};
   out.thermal_alignment = {};
+  out.thermal_nuc = {};
   out.visible_gamma = 1;
   out.stamp = mode == FrontendMode::kThermal ? input.thermal_stamp : input.visible_stamp;
 
@@ -103,6 +105,8 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     return out.status = FrontendStatus::kVisibleUnusable;
   }
   if (use_thermal && input.thermal.empty()) return out.status = FrontendStatus::kThermalUnusable;
+  // The thermal frame as every later step sees it: without its fixed pattern when NUC is on.
+  const cv::Mat* thermal = &input.thermal;
 
   if (use_visible) {
     begin(FrontendStep::kEnhance);
@@ -116,6 +120,10 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
   cv::Mat detect_mask;
   if (use_thermal) {
     begin(FrontendStep::kThermal);
+    if (config_.thermal_nuc.enabled) {
+      out.thermal_nuc = thermal_nuc_.correct(input.thermal, thermal_corrected_);
+      thermal = &thermal_corrected_;
+    }
     // Thermal-only tracking has no visible stamp to compensate to.
     const Eigen::Matrix3d R =
         mode == FrontendMode::kFused ? input.R_camtv_camtt : Eigen::Matrix3d::Identity();
@@ -126,7 +134,7 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     const std::span<const Eigen::Vector3f> points =
         mode == FrontendMode::kFused ? input.p_cam_m : std::span<const Eigen::Vector3f>();
     const bool aligned =
-        aligner_->align(input.thermal, R, thermal_aligned_, out.thermal_alignment, points);
+        aligner_->align(*thermal, R, thermal_aligned_, out.thermal_alignment, points);
     if (aligned) {
       if (config_.thermal_enhance.enabled) {
         thermal_enhancer_.enhance_to_grey(thermal_aligned_, false, thermal_grey_);
@@ -144,9 +152,9 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
           // Corners on the edge of what the thermal lens covers hold still in the image however
           // the camera moves: keep new corners a KLT window away from it.
           const int margin = config_.tracker.klt_window_px;
-          cv::erode(aligner_->valid_mask(), thermal_detect_mask_,
-                    cv::getStructuringElement(cv::MORPH_RECT,
-                                              cv::Size(2 * margin + 1, 2 * margin + 1)));
+          cv::erode(
+              aligner_->valid_mask(), thermal_detect_mask_,
+              cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));
           detect_mask = thermal_detect_mask_;
         }
       }
@@ -166,7 +174,7 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     if (use_visible) out.quality.visible = quality_.assess(visible_grey_);
     if (use_thermal) {
       // For 8-bit frames this is a view of the caller's buffer: enhance into our own.
-      aligner_->native_grey(input.thermal, out.thermal_alignment, thermal_native_);
+      aligner_->native_grey(*thermal, out.thermal_alignment, thermal_native_);
       if (config_.thermal_enhance.enabled) {
         thermal_enhancer_.enhance_to_grey(thermal_native_, false, thermal_native_enhanced_);
         out.quality.thermal = quality_.assess(thermal_native_enhanced_);

@@ -27,6 +27,7 @@
 #include "core/vision/image_quality.hpp"
 #include "core/vision/line_tracker.hpp"
 #include "core/vision/pinhole_camera.hpp"
+#include "core/vision/scene_nuc.hpp"
 #include "core/vision/thermal_aligner.hpp"
 
 namespace posed::vision {
@@ -43,6 +44,7 @@ struct FrontendConfig {
     c.enabled = false;
     return c;
   }();
+  SceneNucConfig thermal_nuc;  ///< the thermal camera's fixed pattern, learnt and subtracted
   ThermalAlignConfig thermal_align;
   FusionConfig fusion;
   bool assess_quality = true;
@@ -91,6 +93,10 @@ class VisualFrontend {
   /// no part of the world (fusion::StaticTrackFilter).
   void drop_tracks(const std::vector<std::uint64_t>& ids) { tracker_.drop(ids); }
 
+  /// The thermal camera's shutter closed (its video froze): its fixed pattern starts afresh, and
+  /// so does what the scene-based NUC learnt of it.
+  void thermal_shutter() { thermal_nuc_.reset(); }
+
   /// The grey images of the last frame (visible size), for inspection and annotation; empty for
   /// streams the mode does not build.
   const cv::Mat& visible_grey() const { return visible_grey_; }
@@ -113,6 +119,7 @@ class VisualFrontend {
   Enhancer visible_enhancer_;
   Enhancer thermal_enhancer_;
   std::unique_ptr<ThermalAligner> aligner_;  // only when the mode uses the thermal stream
+  SceneNuc thermal_nuc_;
   DwtFusion fusion_;
   QualityAssessor quality_;
   FeatureTracker tracker_;
@@ -121,9 +128,10 @@ class VisualFrontend {
   FrontendStepProbe* probe_ = nullptr;
 
   cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, thermal_native_, fused_grey_;
-  cv::Mat thermal_native_enhanced_;
+  cv::Mat thermal_native_enhanced_, thermal_corrected_;
   cv::Mat visible_denoised_, thermal_denoised_;
-  cv::Mat thermal_detect_mask_;  // thermal mode: where new corners may be found  // fusion inputs when FusionConfig::denoise
+  cv::Mat thermal_detect_mask_;  // thermal mode: where new corners may be found  // fusion inputs
+                                 // when FusionConfig::denoise
   // previous frame's features (id order) for the velocities
   std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> previous_;
   HostTime previous_stamp_;

@@ -399,6 +399,12 @@ const Field kSchema[] = {
       "thermal_registration: lidar_depth: cells of the depth grid down the image"),
     F("frontend.rotation_compensation", frontend.rotation_compensation, "true", "", 0, 0, "",
       "warp the thermal frame by the gyro's rotation between its stamp and its visible partner's"),
+    F("frontend.thermal_nuc", frontend.thermal_nuc, "false", "", 0, 0, "",
+      "scene-based non-uniformity correction: learn the thermal camera's fixed pattern from its "
+      "moving video and subtract it, so its corners are the scene's and not the sensor's"),
+    F("frontend.thermal_nuc_frames", frontend.thermal_nuc_frames, "100", "frames", 1, 10000, "",
+      "moving frames each pixel's learnt offset averages over (the pattern grows between the "
+      "camera's flat-field corrections, which start the learning afresh)"),
     F("frontend.wavelet", frontend.wavelet, "haar", "", 0, 0, "haar|legall53|cdf97",
       "wavelet of the 2-level DWT fusion"),
     F("frontend.fusion_noise_weighted", frontend.fusion_noise_weighted, "true", "", 0, 0, "",

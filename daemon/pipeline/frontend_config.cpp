@@ -74,6 +74,8 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   f.thermal_align.depth_grid_cols = s.thermal_depth_grid_cols;
   f.thermal_align.depth_grid_rows = s.thermal_depth_grid_rows;
   f.thermal_align.rotation_compensation = s.rotation_compensation;
+  f.thermal_nuc.enabled = s.thermal_nuc;
+  f.thermal_nuc.average_frames = s.thermal_nuc_frames;
   if (s.wavelet == "legall53") {
     f.fusion.wavelet = vision::Wavelet::kLeGall53;
   } else if (s.wavelet == "cdf97") {

@@ -232,6 +232,29 @@ TEST(VisualFrontend, ThermalEnhancementNeverWritesIntoTheInput) {
   EXPECT_TRUE(frame.quality.thermal.valid);
 }
 
+TEST(VisualFrontend, ThermalNucLearnsWhileMovingAndForgetsAtTheShutter) {
+  FrontendConfig c = config_for(FrontendMode::kThermal);
+  c.thermal_nuc.enabled = true;
+  VisualFrontend frontend(c);
+  FrontendFrame frame;
+  const cv::Mat before = drive().thermal[0].clone();
+  for (int k = 0; k < kFrames; ++k) {
+    ASSERT_EQ(frontend.process(input_for(k), frame), FrontendStatus::kOk);
+    // The first frame has nothing to compare with; each later one moved ~4 px.
+    EXPECT_EQ(frame.thermal_nuc.updates, static_cast<std::uint64_t>(k)) << "frame " << k;
+  }
+  EXPECT_GT(frame.thermal_nuc.offset_rms, 0.0);
+  EXPECT_EQ(cv::norm(before, drive().thermal[0], cv::NORM_INF), 0.0);  // input untouched
+  frontend.thermal_shutter();
+  ASSERT_EQ(frontend.process(input_for(0), frame), FrontendStatus::kOk);
+  EXPECT_EQ(frame.thermal_nuc.updates, 0u);
+  // Off (the default): nothing is learnt.
+  VisualFrontend plain(config_for(FrontendMode::kThermal));
+  ASSERT_EQ(plain.process(input_for(0), frame), FrontendStatus::kOk);
+  ASSERT_EQ(plain.process(input_for(1), frame), FrontendStatus::kOk);
+  EXPECT_EQ(frame.thermal_nuc.updates, 0u);
+}
+
 TEST(VisualFrontend, WrapsCoreImagesWithoutCopying) {
   PayloadPool pool(2, (640 * 3 + 16) * 480);
   Image image;
