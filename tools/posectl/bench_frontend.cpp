@@ -447,6 +447,20 @@ int bench_frontend() {
     report("frontend", "lidar_depth_depth_associated_mean", r.depth, "features");
   }
 
+  // Option: the thermal camera's fixed pattern learnt and subtracted (scene-based NUC), in the
+  // thermal step; thermal-only, where the thermal stream alone is tracked.
+  {
+    vision::FrontendConfig c = config;
+    c.mode = vision::FrontendMode::kThermal;
+    c.thermal_nuc.enabled = true;
+    RunFigures r;
+    run(c, frames, false, r);
+    report("frontend", "thermal_nuc_thermal_median", quantile_ms(r.timer.step(1), 0.5), "ms");
+    report("frontend", "thermal_nuc_total_median", quantile_ms(r.timer.totals(), 0.5), "ms");
+    report("frontend", "thermal_nuc_match_success", r.previous > 0 ? r.inliers / r.previous : 0,
+           "ratio");
+  }
+
   // Option: LSD line features.
   vision::FrontendConfig with_lines = config;
   with_lines.lines = true;
