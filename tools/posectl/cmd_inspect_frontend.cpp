@@ -99,6 +99,10 @@ void print_table(const std::vector<const CameraFigures*>& columns,
       const DepthErrorStats s = stats(c);
       return s.features > 0 ? number(s.p90_abs_m, "%.3f") : std::string("-");
     });
+    row("lidar depth bias vs truth, median [%]", [&](const CameraFigures& c) {
+      const DepthErrorStats s = stats(c);
+      return s.features > 0 ? number(100.0 * s.median_signed_relative, "%+.1f") : std::string("-");
+    });
     row("lidar depth within 10 % of truth [%]", [&](const CameraFigures& c) {
       const DepthErrorStats s = stats(c);
       return s.features > 0 ? number(100.0 * s.within_10_percent, "%.1f") : std::string("-");

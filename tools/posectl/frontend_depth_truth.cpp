@@ -110,6 +110,7 @@ void FrontendDepthTruth::on_frame(const vision::FrontendFrame& frame,
     const double error = std::abs(f.depth_m - z_true);
     abs_errors_m_[m].push_back(error);
     relative_errors_[m].push_back(error / z_true);
+    signed_relative_errors_[m].push_back((f.depth_m - z_true) / z_true);
   }
 }
 
@@ -121,6 +122,7 @@ DepthErrorStats FrontendDepthTruth::stats(vision::FrontendMode mode) const {
   s.median_abs_m = quantile(abs_errors_m_[m], 0.5);
   s.p90_abs_m = quantile(abs_errors_m_[m], 0.9);
   s.median_relative = quantile(relative_errors_[m], 0.5);
+  s.median_signed_relative = quantile(signed_relative_errors_[m], 0.5);
   const auto within = std::count_if(relative_errors_[m].begin(), relative_errors_[m].end(),
                                     [](double r) { return r <= 0.10; });
   s.within_10_percent =

@@ -18,11 +18,13 @@
 namespace posed::posectl {
 
 struct DepthErrorStats {
-  std::uint64_t features = 0;    ///< features with a lidar depth [1]
-  std::uint64_t missed = 0;      ///< of those, whose true ray meets nothing within 200 m [1]
-  double median_abs_m = 0;       ///< median |associated - true| [m]
-  double p90_abs_m = 0;          ///< 90th percentile [m]
-  double median_relative = 0;    ///< median |error| / true depth [-]
+  std::uint64_t features = 0;  ///< features with a lidar depth [1]
+  std::uint64_t missed = 0;    ///< of those, whose true ray meets nothing within 200 m [1]
+  double median_abs_m = 0;     ///< median |associated - true| [m]
+  double p90_abs_m = 0;        ///< 90th percentile [m]
+  double median_relative = 0;  ///< median |error| / true depth [-]
+  /// median (associated - true) / true depth: a bias here scales every camera motion [-]
+  double median_signed_relative = 0;
   double within_10_percent = 0;  ///< share of features within 10 % of the true depth [0..1]
 };
 
@@ -46,7 +48,7 @@ class FrontendDepthTruth final : public fusion::FrontendObserver {
   FrontendDepthTruth() = default;
   std::unique_ptr<World> world_;
   std::string description_;
-  std::array<std::vector<double>, 3> abs_errors_m_, relative_errors_;
+  std::array<std::vector<double>, 3> abs_errors_m_, relative_errors_, signed_relative_errors_;
   std::array<std::uint64_t, 3> missed_{};
 };
 
