@@ -1,5 +1,6 @@
 #include "daemon/extra_outputs.hpp"
 
+#include <chrono>
 #include <vector>
 
 #include "daemon/build_info.hpp"
@@ -63,6 +64,12 @@ bool ExtraOutputs::open(const config::PosedConfig& config, dds::Publisher* publi
 void ExtraOutputs::stop() {
   if (clouds_) clouds_->stop();
   if (images_) images_->stop();
+  // The last messages (the final status after the pipeline drained, the last cloud) are still
+  // queued for the Foxglove clients: written before the summary counts them and the server's
+  // end discards the rest. A client that stopped reading costs at most this second.
+  if (foxglove_ && !foxglove_->flush(std::chrono::seconds(1))) {
+    POSED_LOG_NOTICE("foxglove: a client did not take its last messages within 1 s");
+  }
 }
 
 bool ExtraOutputs::foxglove_reader() const {

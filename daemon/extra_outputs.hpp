@@ -48,7 +48,8 @@ class ExtraOutputs {
             drivers::recording::Recorder* recorder, const ExtraOutputsSetup& setup,
             std::string& error);
   /// Writes the clouds and image still waiting and ends their threads (before the recording
-  /// closes, so they reach it). Idempotent.
+  /// closes, so they reach it), then gives the Foxglove clients up to 1 s to take what is queued
+  /// for them. Idempotent.
   void stop();
 
   /// Whether a Foxglove client subscribes to rt/posed/odom or pose (--wait-subscribers).

@@ -184,6 +184,8 @@ class Session : public std::enable_shared_from_this<Session> {
   bool send(OutFrame&& frame, Admission admission);
   /// Idempotent; ends the connection and takes the client out of the registry.
   void close();
+  /// Bytes queued for the client, the frame being written included. Any thread.
+  std::size_t queued_bytes() const { return outbox_.queued_bytes(); }
 
   /// The client's subscriptions, under Impl::registry_mutex.
   std::map<SubscriptionId, ChannelId> subscriptions;
@@ -566,6 +568,25 @@ std::unique_ptr<Server> Server::start(const ServerOptions& options, std::string&
 Server::~Server() {
   asio::post(impl_->io, [impl = impl_.get()] { impl->shutdown(); });
   if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+bool Server::flush(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    bool drained = true;
+    {
+      std::shared_lock lock(impl_->registry_mutex);
+      for (const auto& session : impl_->sessions) {
+        if (session->queued_bytes() > 0) {
+          drained = false;
+          break;
+        }
+      }
+    }
+    if (drained) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 ChannelId Server::add_channel(const ChannelSpec& spec) {

@@ -12,6 +12,7 @@
 // Standalone: nothing here knows DDS or the daemon; the payloads are whatever the channel's
 // encoding says (CDR for posed's ROS 2 types).
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -76,6 +77,11 @@ class Server {
   /// messages of one thread reach each client in the order published. An id add_channel() did
   /// not return is ignored.
   void publish(ChannelId channel, std::int64_t log_time_ns, std::span<const std::byte> payload);
+
+  /// Waits until every client's queue has been written (or `timeout` passed; then false), so
+  /// what was published last (the run's final status) reaches the clients before the server
+  /// closes their connections, which discards what is queued. Any thread but the I/O thread.
+  bool flush(std::chrono::milliseconds timeout);
 
   /// Whether any client subscribes to `channel` now: lets callers skip encoding. Lock-free.
   bool has_subscribers(ChannelId channel) const;

@@ -312,6 +312,39 @@ TEST(FoxgloveServer, ClientWithoutTheSubprotocolIsRefusedWithAReason) {
   EXPECT_EQ(server->stats().clients_rejected, 2u);
 }
 
+TEST(FoxgloveServer, FlushWritesWhatIsQueuedBeforeTheEnd) {
+  // posed's last status is published just before the server ends: flush() lets it out first.
+  auto server = start_server();
+  const ChannelId status = server->add_channel(spec("/posed/status"));
+  TestClient client;
+  connect_and_greet(client, *server);
+  ASSERT_TRUE(client.subscribe(3, status));
+  ASSERT_TRUE(wait_until([&] { return server->has_subscribers(status); }));
+  const std::string payload(64 << 10, 's');
+  constexpr int kMessages = 20;
+  for (int i = 0; i < kMessages; ++i) server->publish(status, i, bytes_of(payload));
+  ASSERT_TRUE(server->flush(std::chrono::seconds(10)));
+  // Written to the socket by the time flush() returns, not merely queued.
+  EXPECT_EQ(channel_stats(server->stats(), status).messages_sent, std::uint64_t{kMessages});
+  for (int i = 0; i < kMessages; ++i) ASSERT_TRUE(client.next_message_data().has_value()) << i;
+}
+
+TEST(FoxgloveServer, FlushGivesUpOnAClientThatNeverReads) {
+  ServerOptions options;
+  options.max_queued_bytes_per_client = 8 << 20;
+  auto server = start_server(options);
+  const ChannelId cloud = server->add_channel(spec("/posed/cloud"));
+  TestClient stuck;
+  ASSERT_EQ(stuck.connect(server->port(), {.receive_buffer_bytes = 4096}), "");
+  ASSERT_TRUE(stuck.subscribe(1, cloud));
+  ASSERT_TRUE(wait_until([&] { return server->has_subscribers(cloud); }));
+  const std::string payload(1 << 20, 'c');
+  for (int i = 0; i < 6; ++i) server->publish(cloud, i, bytes_of(payload));  // beyond the buffers
+  const auto began = std::chrono::steady_clock::now();
+  EXPECT_FALSE(server->flush(std::chrono::milliseconds(200)));
+  EXPECT_GE(std::chrono::steady_clock::now() - began, std::chrono::milliseconds(200));
+}
+
 TEST(FoxgloveServer, ClientThatNeverReadsDoesNotBlockPublish) {
   ServerOptions options;
   options.max_queued_bytes_per_client = 256 << 10;
