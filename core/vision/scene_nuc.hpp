@@ -2,7 +2,7 @@
 // Scene-based non-uniformity correction of the thermal stream: a microbolometer's fixed pattern
 // (each element's and each column's offset, growing between the camera's flat-field corrections)
 // is estimated from the video itself and subtracted, as the temporal high-pass NUC of Scribner et
-// al. (1991) with a motion gate (Harris & Chiang 1999). Each pixel's offset is the running mean of
+// al. (1991), learning only while the image moves. Each pixel's offset is the running mean of
 // its spatial high-pass I - box(I): while the camera moves, the scene's detail passes over a pixel
 // and averages out, and what stays is the pixel's own offset. Without it, a thermal camera in a
 // scene of little contrast (a smoky roadway, a plain wall) tracks its own pattern: corners that
