@@ -65,8 +65,16 @@ int main(int argc, char** argv) noexcept try {
                    "own latency; raw recordings only (an imported ROS 1 topic keeps its header "
                    "stamps)")
           ->needs(replay);
-  app.add_flag("--loop", options.replay.loop, "replay the recording again and again")
-      ->needs(replay);
+  auto* loop =
+      app.add_flag(
+             "--loop", options.replay.loop,
+             "replay the recording again and again, each pass from a fresh start (decoders, "
+             "clock sync and estimator as on the first), its stamps continuing where the last "
+             "pass ended; until SIGINT/SIGTERM or --passes")
+          ->needs(replay);
+  app.add_option("--passes", options.replay.max_passes,
+                 "with --loop: stop after this many passes (0: until a signal)")
+      ->needs(loop);
   app.add_option("--start", options.replay.start_s, "skip this much of the recording [s]")
       ->check(CLI::NonNegativeNumber)
       ->needs(replay);

@@ -72,8 +72,19 @@ PoseSinks::PoseSinks(const config::PosedConfig& config, dds::Publisher* publishe
       path_(config.publish.path_min_step_m,
             static_cast<std::size_t>(config.publish.path_max_poses)) {}
 
+void PoseSinks::new_pass() {
+  pass_start_ = true;
+  // Until the new estimator's first optimised state, its propagation is decimated onto pose,
+  // as on the first pass.
+  tally_.have_optimised = false;
+  path_.clear();
+}
+
 void PoseSinks::odom(const NavState& s) {
-  if (tally_.last) tally_.distance_m += (s.p_map_base_m - tally_.last->p_map_base_m).norm();
+  if (tally_.last && !pass_start_) {
+    tally_.distance_m += (s.p_map_base_m - tally_.last->p_map_base_m).norm();
+  }
+  pass_start_ = false;
   if (!tally_.first) tally_.first = s;
   tally_.last = s;
   if (odom_index_++ % static_cast<std::uint64_t>(config_.publish.odom_decimation) != 0) return;

@@ -113,6 +113,10 @@ class PoseSinks {
   /// time in a replay (the newest state's) and start with its first state.
   void static_transforms();
 
+  /// The next `--replay --loop` pass begins (call while no pipeline runs): its estimate starts
+  /// again from the origin, so the path starts afresh and the jump back is no distance travelled.
+  void new_pass();
+
   /// The last status line ("starting" before the first status); safe from any thread.
   std::string status_line() const;
   const PublishTally& tally() const { return tally_; }
@@ -129,6 +133,8 @@ class PoseSinks {
   bool live_clock_;
   Duration pose_period_;
   std::uint64_t odom_index_ = 0;
+  /// the next odometry is a pass's first (new_pass())
+  bool pass_start_ = false;
   HostTime next_tf_stamp_;
   /// publisher thread: the newest state's stamp (a replay's status carries it)
   std::optional<HostTime> newest_state_stamp_;

@@ -32,6 +32,8 @@ class PathBuilder {
       : min_step_m_(min_step_m), max_poses_(max_poses) {}
   void add(const dds::PoseMessage& pose);
   const dds::PathMessage& path() const { return path_; }
+  /// A new trajectory begins (the next --loop pass): the path starts empty again.
+  void clear() { path_.poses.clear(); }
 
  private:
   double min_step_m_;

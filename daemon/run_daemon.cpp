@@ -11,6 +11,7 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <vector>
 
 #include "daemon/build_info.hpp"
 #include "daemon/dds/publisher.hpp"
@@ -29,6 +30,7 @@
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
 #include "drivers/recording/map_files.hpp"
+#include "drivers/recording/mcap_replay_source.hpp"
 #include "drivers/recording/recorder.hpp"
 
 namespace posed {
@@ -70,6 +72,45 @@ bool save_map(const pipeline::Pipeline& pipe, const std::string& map_path, HostT
                 keyframes_path.c_str());
   line = buf;
   return true;
+}
+
+/// How far the next --loop pass is shifted past the start of the last one: the span every
+/// stream together delivered, plus the IMU's last sample interval, so the stamps go on as if the
+/// recording continued. Nullopt when the pass delivered nothing.
+std::optional<Duration> next_pass_shift(
+    const std::vector<const drivers::recording::McapReplaySource*>& replayers) {
+  std::optional<std::int64_t> first_ns, last_ns;
+  std::int64_t gap_ns = 0;
+  for (const auto* r : replayers) {
+    const auto span = r->delivered_span();
+    if (span.messages == 0) continue;
+    first_ns = first_ns ? std::min(*first_ns, span.first_log_ns) : span.first_log_ns;
+    last_ns = last_ns ? std::max(*last_ns, span.last_log_ns) : span.last_log_ns;
+    if (r->name() == "imu") gap_ns = span.last_gap_ns;
+  }
+  if (!first_ns) return std::nullopt;
+  return Duration::from_ns(*last_ns - *first_ns + std::max<std::int64_t>(gap_ns, 1));
+}
+
+/// One line per --loop pass: where it ended and what the estimator held, so a pass unlike the
+/// others (a divergence) shows.
+void log_pass(std::uint64_t pass, const pipeline::Pipeline& pipe, const PoseSinks& sinks) {
+  const pipeline::PipelineStatus st = pipe.status();
+  const FusionFigures& f = st.estimator;
+  char end[96] = "no pose";
+  if (const auto& last = sinks.tally().last) {
+    std::snprintf(end, sizeof end, "ended at (%.2f, %.2f, %.2f) m", last->p_map_base_m.x(),
+                  last->p_map_base_m.y(), last->p_map_base_m.z());
+  }
+  char depth[64] = "";
+  if (f.camera.features_total > 0) {
+    std::snprintf(depth, sizeof depth, ", lidar depth for %.1f %% of features",
+                  100.0 * static_cast<double>(f.camera.depth_total) /
+                      static_cast<double>(f.camera.features_total));
+  }
+  POSED_LOG_INFO("--loop pass %llu: %s, accel bias %.3f m/s^2, %llu re-initialisations%s",
+                 static_cast<unsigned long long>(pass), end, f.accel_bias_mps2.norm(),
+                 static_cast<unsigned long long>(f.reinitialisations), depth);
 }
 
 }  // namespace
@@ -120,6 +161,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
 
   pipeline::BuiltSources built;
   std::string replay_streams;
+  std::vector<const drivers::recording::McapReplaySource*> replayers;
   if (replaying) {
     pipeline::ReplaySources replay = pipeline::make_replay_sources(options.replay, error);
     // Replayed stamps are the recording's host clock; its wall offset keeps the DDS stamps (and
@@ -128,6 +170,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     if (replay.have_host_to_wall && !options.replay.live_stamps) to_wall = replay.host_to_wall;
     built = std::move(replay.built);
     replay_streams = replay.streams;
+    replayers = std::move(replay.replayers);
     if (options.replay.recorded_config) {
       POSED_LOG_INFO("configuration as recorded in %s%s%s", options.replay.path.c_str(),
                      built.sources.lidar_calibration_text.empty() ? "" : "; lidar calibration: ",
@@ -202,90 +245,131 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
-  pipeline::Pipeline pipe(config, std::move(built.sources), std::move(outputs));
-  const HostTime pipeline_started = drivers::host_now();
-  if (!pipe.start(error)) {
-    POSED_LOG_ERROR("cannot start the pipeline: %s", error.c_str());
-    return 1;
-  }
-
+  // A --loop replay runs pass after pass, each through a pipeline of its own: decoders, clock
+  // sync and estimator start afresh as they did on the first pass, so no pass inherits the one
+  // before it (the robot teleported back to the start). Its stamps go on increasing: each pass is
+  // shifted to start one IMU period after the last one ended.
+  std::unique_ptr<pipeline::Pipeline> pipe;
   notify::SdNotifier notifier;
   notify::StageWatchdog watchdog;
-  // Only the stages this pipeline runs are watched; a stage that never started cannot stall.
   std::vector<notify::StageWatchdog::StageId> watched;
-  for (const std::string& stage : pipe.stage_names()) {
-    watched.push_back(watchdog.register_stage(
-        stage, Duration::from_seconds(config.watchdog.stage_deadline_s), started));
-  }
   notify::WatchdogPinger pinger(notifier.watchdog_interval());
-  notifier.notify("READY=1\nSTATUS=sources open, aligning");
-  char dds_part[128] = "offline, no DDS";
-  if (publisher) {
-    std::snprintf(dds_part, sizeof dds_part,
-                  "on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
-                  config.dds.domain_id);
-  }
-  if (replaying) {
-    POSED_LOG_INFO("replaying %s (%s) %s", options.replay.path.c_str(), replay_streams.c_str(),
-                   dds_part);
-  } else {
-    POSED_LOG_INFO("running: imu %s%s %s", config.imu.source.c_str(),
-                   config.lidar.enabled ? ", lidar" : "", dds_part);
-  }
-
+  const HostTime pipeline_started = drivers::host_now();
   int exit_code = 0;
   bool stopping = false;
   HostTime next_status_line = started + Duration::from_s(1);
   const timespec poll_period{0, 100'000'000};
-  while (!pipe.finished()) {
-    siginfo_t info{};
-    const int sig = sigtimedwait(&signals, &info, &poll_period);
-    const HostTime now = drivers::host_now();
-    if (sig == SIGTERM || sig == SIGINT) {
-      if (stopping) {
-        POSED_LOG_ERROR("second %s: aborting without draining", strsignal(sig));
-        std::_Exit(128 + sig);
+  std::uint64_t passes = 0;
+  Duration pass_shift = Duration::from_ns(0);
+  HostTime pass_started = started;
+  for (;;) {
+    if (passes > 0) pass_started = drivers::host_now();
+    pipe = std::make_unique<pipeline::Pipeline>(config, std::move(built.sources), outputs);
+    if (!pipe->start(error)) {
+      POSED_LOG_ERROR("cannot start the pipeline: %s", error.c_str());
+      return 1;
+    }
+    if (passes == 0) {
+      // Only the stages this pipeline runs are watched; a stage that never started cannot
+      // stall. Every pass runs the same stages.
+      for (const std::string& stage : pipe->stage_names()) {
+        watched.push_back(watchdog.register_stage(
+            stage, Duration::from_seconds(config.watchdog.stage_deadline_s), started));
       }
-      POSED_LOG_INFO("%s: draining and stopping", strsignal(sig));
-      notifier.notify("STOPPING=1\nSTATUS=draining");
-      stopping = true;
-      pipe.request_stop();
-    } else if (sig == SIGHUP) {
-      POSED_LOG_NOTICE("SIGHUP: no setting can be reloaded while running yet; restart to apply");
+      notifier.notify("READY=1\nSTATUS=sources open, aligning");
+      char dds_part[128] = "offline, no DDS";
+      if (publisher) {
+        std::snprintf(dds_part, sizeof dds_part,
+                      "on DDS domain %d (rt/posed/odom, rt/posed/pose, rt/posed/status)",
+                      config.dds.domain_id);
+      }
+      if (replaying) {
+        POSED_LOG_INFO("replaying %s (%s) %s%s", options.replay.path.c_str(),
+                       replay_streams.c_str(), dds_part,
+                       options.replay.loop ? ", pass after pass (--loop)" : "");
+      } else {
+        POSED_LOG_INFO("running: imu %s%s %s", config.imu.source.c_str(),
+                       config.lidar.enabled ? ", lidar" : "", dds_part);
+      }
     }
-    if (!stopping && !replaying && options.duration_s > 0 &&
-        (now - started).seconds() >= options.duration_s) {
-      POSED_LOG_INFO("--duration %.1f s reached: draining and stopping", options.duration_s);
-      notifier.notify("STOPPING=1\nSTATUS=draining");
-      stopping = true;
-      pipe.request_stop();
+
+    while (!pipe->finished()) {
+      siginfo_t info{};
+      const int sig = sigtimedwait(&signals, &info, &poll_period);
+      const HostTime now = drivers::host_now();
+      if (sig == SIGTERM || sig == SIGINT) {
+        if (stopping) {
+          POSED_LOG_ERROR("second %s: aborting without draining", strsignal(sig));
+          std::_Exit(128 + sig);
+        }
+        POSED_LOG_INFO("%s: draining and stopping", strsignal(sig));
+        notifier.notify("STOPPING=1\nSTATUS=draining");
+        stopping = true;
+        pipe->request_stop();
+      } else if (sig == SIGHUP) {
+        POSED_LOG_NOTICE("SIGHUP: no setting can be reloaded while running yet; restart to apply");
+      }
+      if (!stopping && !replaying && options.duration_s > 0 &&
+          (now - started).seconds() >= options.duration_s) {
+        POSED_LOG_INFO("--duration %.1f s reached: draining and stopping", options.duration_s);
+        notifier.notify("STOPPING=1\nSTATUS=draining");
+        stopping = true;
+        pipe->request_stop();
+      }
+      const std::vector<pipeline::StageBeat> beats = pipe->stage_heartbeats();
+      for (std::size_t i = 0; i < watched.size() && i < beats.size(); ++i) {
+        watchdog.heartbeat(watched[i], beats[i].last);
+      }
+      const std::string line = sinks.status_line();
+      if (const auto message = pinger.poll(now, watchdog.check(now), line)) {
+        notifier.notify(*message);
+      }
+      // While a stage stalls the pinger's STATUS= names it; ours would hide that.
+      if (now >= next_status_line && !pinger.reporting_stall()) {
+        next_status_line = now + Duration::from_s(1);
+        notifier.notify("STATUS=" + line);
+      }
     }
-    const std::vector<pipeline::StageBeat> beats = pipe.stage_heartbeats();
-    for (std::size_t i = 0; i < watched.size() && i < beats.size(); ++i) {
-      watchdog.heartbeat(watched[i], beats[i].last);
+    pipe->join();
+    ++passes;
+    if (!replaying || !options.replay.loop) break;
+    log_pass(passes, *pipe, sinks);
+    if (stopping || (options.replay.max_passes > 0 && passes >= options.replay.max_passes)) break;
+    const std::optional<Duration> next_shift = next_pass_shift(replayers);
+    if (!next_shift) {
+      POSED_LOG_WARN("--loop: pass %llu replayed nothing; stopping",
+                     static_cast<unsigned long long>(passes));
+      break;
     }
-    const std::string line = sinks.status_line();
-    if (const auto message = pinger.poll(now, watchdog.check(now), line)) notifier.notify(*message);
-    // While a stage stalls the pinger's STATUS= names it; ours would hide that.
-    if (now >= next_status_line && !pinger.reporting_stall()) {
-      next_status_line = now + Duration::from_s(1);
-      notifier.notify("STATUS=" + line);
+    pass_shift = pass_shift + *next_shift;
+    pipeline::ReplayOptions next = options.replay;
+    next.time_shift = pass_shift;
+    pipeline::ReplaySources replay = pipeline::make_replay_sources(next, error);
+    if (!replay.built.sources.imu) {
+      POSED_LOG_ERROR("--loop pass %llu: %s", static_cast<unsigned long long>(passes + 1),
+                      error.c_str());
+      exit_code = 1;
+      break;
     }
+    // The last pass's pipeline, with its Sources, goes when the next one replaces it.
+    built = std::move(replay.built);
+    replayers = std::move(replay.replayers);
+    if (recorder) pipeline::tap_sources(built.sources, *recorder, config);
+    sinks.new_pass();
   }
-  pipe.join();
   extra.stop();  // the last clouds and images reach the recording too
   if (recorder && !recorder->close()) {
     POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());
     exit_code = 1;
   }
   std::string map_line;
-  if (!options.map_path.empty() && !save_map(pipe, options.map_path, to_wall, map_line))
+  if (!options.map_path.empty() && !save_map(*pipe, options.map_path, to_wall, map_line))
     exit_code = 1;
 
-  const RunSummary summary{config,         options,          pipe,           sinks,
-                           started,        pipeline_started, replay_streams, built_has_lidar,
-                           recorder.get(), map_line,         synthetic,      publisher != nullptr,
-                           extra.clouds(), extra.foxglove(), extra.images()};
+  const RunSummary summary{
+      config,         options,          *pipe,          sinks,    started,     pipeline_started,
+      replay_streams, built_has_lidar,  recorder.get(), map_line, synthetic,   publisher != nullptr,
+      extra.clouds(), extra.foxglove(), extra.images(), passes,   pass_started};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

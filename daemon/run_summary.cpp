@@ -31,6 +31,8 @@ bool print_run_summary(const RunSummary& r) {
   std::printf("  run time            %.1f s\n", run_s);
   std::printf("  estimator           %s, last mode %s\n", r.pipe.estimator_description().c_str(),
               std::string(to_string(st.mode)).c_str());
+  // The stream counts are the last --loop pass's: their rates are over its time.
+  const double streams_s = (drivers::host_now() - r.last_pass_started).seconds();
   for (const auto& s : st.streams) {
     // Chunks nothing could decode are a configuration problem, not damaged data: said apart.
     char undecodable[80] = "";
@@ -48,7 +50,7 @@ bool print_run_summary(const RunSummary& r) {
         "  %-19s %llu decoded (%.1f Hz mean), %llu malformed%s%s, %llu dropped; clock %s, "
         "offset %.3f ms, drift %.1f ppm\n",
         s.name.c_str(), static_cast<unsigned long long>(s.decoded),
-        run_s > 0 ? static_cast<double>(s.decoded) / run_s : 0.0,
+        streams_s > 0 ? static_cast<double>(s.decoded) / streams_s : 0.0,
         static_cast<unsigned long long>(s.malformed), undecodable, refused,
         static_cast<unsigned long long>(s.dropped), s.clock_state.c_str(),
         static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
@@ -56,6 +58,12 @@ bool print_run_summary(const RunSummary& r) {
   if (!r.options.replay.path.empty()) {
     std::printf("  replayed            %s (%s)\n", r.options.replay.path.c_str(),
                 r.replay_streams.c_str());
+    if (r.options.replay.loop) {
+      std::printf(
+          "  passes              %llu, each from a fresh start (decoders, clock sync, "
+          "estimator); the stream and estimator figures are the last pass's\n",
+          static_cast<unsigned long long>(r.passes));
+    }
     // What a replay costs: the span of data turned into poses per second of wall time.
     const double processing_s = (drivers::host_now() - r.pipeline_started).seconds();
     if (tally.first && tally.last && processing_s > 0) {

@@ -44,6 +44,8 @@ struct RunSummary {
   const CloudOutput* clouds = nullptr;  ///< stopped; null: no cloud or map output
   const foxglove::Server* foxglove = nullptr;  ///< null: no Foxglove server
   const ImageOutput* images = nullptr;         ///< stopped; null: no image output
+  std::uint64_t passes = 1;    ///< over the recording (--loop); the figures above are the last's
+  HostTime last_pass_started;  ///< the last pass's start (its streams' mean rates)
 };
 
 /// Prints it to stdout; false when there was no pose at all (the estimator never aligned).

@@ -92,9 +92,13 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     c.rate = options.rate;
     c.start_offset = Duration::from_seconds(options.start_s);
     c.duration = Duration::from_seconds(options.duration_s);
-    c.loop = options.loop;
+    // One pass: run_daemon runs the next through a pipeline of its own (options.loop).
+    c.loop = false;
+    c.time_shift = options.time_shift;
     c.live_timeline = timeline;
-    return std::make_unique<recording::McapReplaySource>(std::move(c));
+    auto source = std::make_unique<recording::McapReplaySource>(std::move(c));
+    out.replayers.push_back(source.get());
+    return source;
   };
   out.built.sources.imu = make("imu");
   out.built.sources.paced = options.rate > 0;

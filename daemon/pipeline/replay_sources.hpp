@@ -3,10 +3,16 @@
 // passed to the same Pipeline as the live Sources. They are not live, so the pipeline's queues
 // block instead of dropping and a replay at full speed is deterministic.
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/time.hpp"
 #include "daemon/pipeline/source_factory.hpp"
+
+namespace posed::drivers::recording {
+class McapReplaySource;
+}
 
 namespace posed::pipeline {
 
@@ -18,7 +24,13 @@ struct ReplayOptions {
   double start_s = 0;
   /// replay only this much of it; 0 = to the end [s]
   double duration_s = 0;
+  /// run pass after pass (run_daemon), each through a pipeline of its own; the Sources made
+  /// here replay one pass
   bool loop = false;
+  /// with loop: stop after this many passes; 0 = until a signal
+  std::uint64_t max_passes = 0;
+  /// added to every receive time (a --loop pass after the first starts where the last ended)
+  Duration time_shift = Duration::from_ns(0);
   /// at recorded timing, re-stamped onto the host clock now (ReplayTimeline): the replay looks
   /// live to ClockSync, the estimator and DDS subscribers (rate must be 1)
   bool live_stamps = false;
@@ -34,6 +46,8 @@ struct ReplaySources {
   bool have_host_to_wall = false;
   /// streams found, e.g. "imu, lidar"
   std::string streams;
+  /// the replay Sources in `built`, to ask what a pass delivered (valid while they live)
+  std::vector<const drivers::recording::McapReplaySource*> replayers;
 };
 
 /// On failure the sources are empty and `error` names the file and the problem.

@@ -14,7 +14,9 @@ namespace posed::drivers::recording {
 namespace {}  // namespace
 
 McapReplaySource::McapReplaySource(McapReplayConfig config)
-    : config_(std::move(config)), name_(config_.name.empty() ? config_.stream : config_.name) {}
+    : config_(std::move(config)),
+      name_(config_.name.empty() ? config_.stream : config_.name),
+      loop_shift_ns_(config_.time_shift.ns) {}
 
 bool McapReplaySource::wanted(const McapChannelRecord& c) const {
   return raw::is_stream_channel(c.message_encoding, c.metadata) &&
@@ -110,6 +112,7 @@ bool McapReplaySource::fetch() {
       return false;
     }
     prev_log_ns_ = delivered_this_pass_ > 0 ? last_log_ns_ : log;
+    if (delivered_this_pass_ == 0) pass_first_log_ns_ = log;
     last_log_ns_ = log;
     ++delivered_this_pass_;
     pending_ = m;
@@ -167,6 +170,16 @@ void McapReplaySource::request_stop() {
   stop_.store(true, std::memory_order_relaxed);
   std::lock_guard lock(wait_mutex_);
   wait_cv_.notify_all();
+}
+
+McapReplaySource::DeliveredSpan McapReplaySource::delivered_span() const {
+  DeliveredSpan span;
+  span.messages = delivered_this_pass_;
+  if (span.messages == 0) return span;
+  span.first_log_ns = pass_first_log_ns_;
+  span.last_log_ns = last_log_ns_;
+  span.last_gap_ns = span.messages > 1 ? last_log_ns_ - prev_log_ns_ : 0;
+  return span;
 }
 
 SourceCounters McapReplaySource::counters() const { return counts_.snapshot(); }

@@ -64,6 +64,9 @@ struct McapReplayConfig {
   /// start again at the end; host_receive keeps increasing (each pass is shifted by the span
   /// replayed plus one inter-message gap) so clock sync downstream sees time move forward
   bool loop = false;
+  /// added to every receive time: a pass of `posed --replay --loop` after the first, which runs
+  /// through a pipeline of its own, starts where the pass before it ended
+  Duration time_shift = Duration::from_ns(0);
   /// shared by the replay's Sources: paced at recorded timing (rate is ignored) and re-stamped
   /// onto the host clock now; null: receive times are the recorded log times
   std::shared_ptr<ReplayTimeline> live_timeline;
@@ -100,6 +103,17 @@ class McapReplaySource final : public Source {
   /// completed passes over the recording (loop)
   std::uint64_t passes() const { return passes_; }
 
+  /// What the current (or last) pass delivered, in recorded log time (time_shift not added).
+  struct DeliveredSpan {
+    std::uint64_t messages = 0;
+    std::int64_t first_log_ns = 0;
+    std::int64_t last_log_ns = 0;
+    /// between the last two messages (0 with fewer than two)
+    std::int64_t last_gap_ns = 0;
+  };
+  /// Call when the Source is not being read (after the pipeline joined).
+  DeliveredSpan delivered_span() const;
+
  private:
   bool fetch();  // the next message of the stream into pending_, applying offset/duration/loop
   bool wanted(const McapChannelRecord& c) const;
@@ -118,6 +132,7 @@ class McapReplaySource final : public Source {
   bool have_first_ = false;
   std::int64_t first_log_ns_ = 0;  // the stream's first message in the file
   std::int64_t last_log_ns_ = 0, prev_log_ns_ = 0;
+  std::int64_t pass_first_log_ns_ = 0;  // the first message delivered in this pass
   std::int64_t loop_shift_ns_ = 0;
   std::uint64_t passes_ = 0;
   std::uint64_t delivered_this_pass_ = 0;

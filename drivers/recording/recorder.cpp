@@ -111,8 +111,18 @@ std::uint16_t Recorder::add_raw_channel(std::string_view stream, std::string_vie
   md[std::string(raw::kStreamKey)] = stream;
   md[std::string(raw::kWireFormatKey)] = wire_format;
   md[std::string(raw::kSourceChannelKey)] = std::to_string(source_channel);
+  std::string topic = raw::topic(stream, source_channel);
   std::lock_guard lock(mutex_);
-  return add_channel(Kind::kRaw, raw::topic(stream, source_channel), std::move(md));
+  // The same channel again (a `posed --replay --loop` pass after the first taps fresh Sources):
+  // its messages go on in the channel it already has.
+  const std::size_t n = channel_count_.load(std::memory_order_relaxed);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Channel& c = *channels_[i];
+    if (c.kind == Kind::kRaw && c.topic == topic && c.metadata == md) {
+      return static_cast<std::uint16_t>(i);
+    }
+  }
+  return add_channel(Kind::kRaw, std::move(topic), std::move(md));
 }
 
 std::uint16_t Recorder::pose_channel(std::string_view topic, Kind kind) {

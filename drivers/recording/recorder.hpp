@@ -86,7 +86,8 @@ class Recorder {
   /// Creates the first file and starts the writer thread. false + `error` on failure.
   bool open(const std::string& path, const RecorderOptions& options, std::string& error);
 
-  /// A raw channel for one Source channel: returns its id, or kInvalidChannel when full.
+  /// A raw channel for one Source channel: returns its id, or kInvalidChannel when full. The
+  /// same topic with the same metadata again returns the channel it already has.
   /// `metadata`: sensor config / calibration text / device, stored in the Channel record.
   std::uint16_t add_raw_channel(std::string_view stream, std::string_view wire_format,
                                 const std::map<std::string, std::string>& metadata = {},

@@ -117,6 +117,54 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
   EXPECT_LT(ate, 0.10) << "ATE " << ate << " m over " << pairs.size() << " poses";
 }
 
+TEST(LioReplay, EveryLoopPassStartsAfreshAndRepeatsTheFirst) {
+  // `posed --replay --loop`: each pass runs through a pipeline of its own, so it gives the first
+  // pass's poses again (not a robot teleported back with the last pass's estimate), stamped
+  // after the pass before it.
+  TempDir dir;
+  const std::string recording = dir.file("street.mcap");
+  {
+    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night",
+                      "--duration", "6", "--seed", "8", "--no-cameras", "--config",
+                      source_dir() + "/config/posed.yaml", "-o", recording},
+                     {}, dir);
+    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+  }
+  const std::string config =
+      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
+                                  "\n  cyclonedds_config: " + source_dir() +
+                                  "/config/cyclonedds-loopback.xml\n");
+  PosedProcess posed(
+      {build_dir() + "/daemon/posed", "--config", config, "--replay", recording, "--max-speed",
+       "--loop", "--passes", "3", "--wait-subscribers", "0", "--record", dir.file("loop.mcap")},
+      {}, dir);
+  ASSERT_EQ(posed.wait_for_exit(120s), 0) << posed.err();
+  EXPECT_NE(posed.out().find("passes              3, each from a fresh start"), std::string::npos)
+      << posed.out();
+  EXPECT_NE(posed.err().find("--loop pass 3: ended at"), std::string::npos) << posed.err();
+
+  const auto poses = recorded_poses(dir.file("loop.mcap"), "/posed/pose", false);
+  ASSERT_GT(poses.size(), 3u * 30u);
+  ASSERT_EQ(poses.size() % 3, 0u) << "every pass gives as many poses as the first";
+  const std::vector<std::pair<std::int64_t, rec::ros2::StampedPose>> all(poses.begin(),
+                                                                         poses.end());
+  const std::size_t n = all.size() / 3;
+  const std::int64_t pass_period_ns = all[n].first - all[0].first;
+  // The pass lasts about the recording's 6 s; the next starts right after it.
+  EXPECT_GT(pass_period_ns, 5'900'000'000);
+  EXPECT_LT(pass_period_ns, 6'100'000'000);
+  for (std::size_t pass = 1; pass < 3; ++pass) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& first = all[i];
+      const auto& again = all[pass * n + i];
+      ASSERT_EQ(again.first - first.first, static_cast<std::int64_t>(pass) * pass_period_ns)
+          << "pass " << pass + 1 << " pose " << i;
+      ASSERT_LT((position(again.second) - position(first.second)).norm(), 1e-6)
+          << "pass " << pass + 1 << " pose " << i << " differs from the first pass's";
+    }
+  }
+}
+
 /// A whole file's bytes.
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -159,6 +159,28 @@ TEST(RecordReplay, LoopRepeatsTheBytesWithIncreasingStamps) {
   EXPECT_EQ(src.read(chunk, Duration::from_ms(10)), ReadStatus::kEndOfStream);
 }
 
+TEST(RecordReplay, ATimeShiftMovesEveryStampAndTheDeliveredSpanIsRecordedTime) {
+  // `posed --replay --loop` runs each pass through Sources of its own, shifted past the last.
+  test::TempDir dir("rec_shift");
+  const auto rec = record_synthetic(dir.file("s.mcap"), 0.2);
+  McapReplayConfig c = cfg(dir.file("s.mcap"), "imu", 0);
+  c.time_shift = Duration::from_seconds(7.5);
+  McapReplaySource src(c);
+  std::string error;
+  ASSERT_TRUE(src.open(error)) << error;
+  EXPECT_EQ(src.delivered_span().messages, 0u);
+  const auto got = replay_all(src);
+  ASSERT_EQ(got.stamps_ns.size(), rec.stamps_ns.size());
+  for (std::size_t i = 0; i < got.stamps_ns.size(); ++i) {
+    ASSERT_EQ(got.stamps_ns[i], rec.stamps_ns[i] + 7'500'000'000) << "message " << i;
+  }
+  const auto span = src.delivered_span();
+  EXPECT_EQ(span.messages, rec.stamps_ns.size());
+  EXPECT_EQ(span.first_log_ns, rec.stamps_ns.front());
+  EXPECT_EQ(span.last_log_ns, rec.stamps_ns.back());
+  EXPECT_EQ(span.last_gap_ns, rec.stamps_ns.back() - rec.stamps_ns[rec.stamps_ns.size() - 2]);
+}
+
 TEST(RecordReplay, OriginalTimingIsKeptScaledByTheRate) {
   test::TempDir dir("rec_rate");
   const auto rec = record_synthetic(dir.file("r.mcap"), 0.4);
@@ -220,6 +242,28 @@ TEST(Recorder, DropsAreCountedAndEverythingAcceptedIsWritten) {
   EXPECT_EQ(r.summary().message_count, accepted);
   // A bad id is refused, not a crash.
   EXPECT_FALSE(rec.record(77, RawChunk{packet, HostTime::from_ns(0), 0}));
+}
+
+TEST(Recorder, TheSameRawChannelAgainKeepsItsIdAndOneChannelRecord) {
+  // A --loop pass taps fresh Sources of the same streams: one channel each in the file.
+  test::TempDir dir("rec_same");
+  Recorder rec;
+  std::string error;
+  ASSERT_TRUE(rec.open(dir.file("s.mcap"), RecorderOptions{}, error)) << error;
+  const auto a = rec.add_raw_channel("imu", raw::kWireA9Serial, {{"config", "x"}});
+  const auto b = rec.add_raw_channel("imu", raw::kWireA9Serial, {{"config", "x"}});
+  const auto other = rec.add_raw_channel("imu", raw::kWireA9Serial, {{"config", "y"}});
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, other);
+  std::vector<std::byte> bytes(16, std::byte{1});
+  EXPECT_TRUE(rec.record(a, RawChunk{bytes, HostTime::from_ns(1), 0}));
+  EXPECT_TRUE(rec.record(b, RawChunk{bytes, HostTime::from_ns(2), 0}));
+  ASSERT_TRUE(rec.close());
+  EXPECT_EQ(rec.counters().channels.size(), 2u);
+  McapReader r;
+  ASSERT_TRUE(r.open(dir.file("s.mcap"), error)) << error;
+  EXPECT_EQ(r.channels().size(), 2u);
+  EXPECT_EQ(r.summary().message_count, 2u);
 }
 
 TEST(Recorder, RotatesBySizeAndEveryFileIsComplete) {
