@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <utility>
@@ -66,6 +67,15 @@ bool MappedFile::open(const std::string& path, std::string& error, std::string_v
   ::madvise(p, size_, MADV_SEQUENTIAL);
   data_ = static_cast<const std::byte*>(p);
   return true;
+}
+
+void MappedFile::release(std::size_t begin, std::size_t end) {
+  static const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  begin = (begin + page - 1) / page * page;
+  end = std::min(end, size_) / page * page;
+  if (data_ == nullptr || end <= begin) return;
+  // MAP_PRIVATE and never written: dropped pages read back from the file unchanged.
+  ::madvise(const_cast<std::byte*>(data_) + begin, end - begin, MADV_DONTNEED);
 }
 
 }  // namespace posed::drivers::recording

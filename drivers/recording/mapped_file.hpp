@@ -24,6 +24,10 @@ class MappedFile {
   bool open(const std::string& path, std::string& error, std::string_view kind = "file");
   /// Unmaps; bytes() is empty afterwards.
   void close();
+  /// Drops the pages wholly inside bytes [begin, end) from this process's resident memory (a
+  /// reader walking front to back is done with them): without it a long replay's RSS grows by
+  /// the recording's size. Their bytes stay readable: the kernel pages them in again if touched.
+  void release(std::size_t begin, std::size_t end);
   std::span<const std::byte> bytes() const { return {data_, size_}; }
   const std::string& path() const { return path_; }
 

@@ -52,6 +52,9 @@ const char* mcap::op_name(std::uint8_t opcode) {
 
 namespace {
 
+/// How much read file next() lets accumulate before it releases it from memory (one madvise).
+constexpr std::uint64_t kReleaseStepBytes = 32u << 20;
+
 std::string fmt(const char* f, auto... args) {
   char buf[256];
   std::snprintf(buf, sizeof buf, f, args...);
@@ -306,6 +309,7 @@ bool McapReader::parse_channel(std::span<const std::byte> body, std::uint64_t of
 
 void McapReader::rewind() {
   pos_ = data_start_;
+  released_ = 0;
   done_ = false;
   complete_ = false;
   stop_reason_.clear();
@@ -471,6 +475,13 @@ bool McapReader::next(McapMessage& out) {
     if (!chunk_records_.empty() && next_in_chunk(out)) return true;
     if (done_) return false;
     const std::uint64_t at = pos_;
+    // What lies before this record (and before the data CRC's position) is read: out of
+    // resident memory with it, in steps large enough to cost nothing.
+    const std::uint64_t done_with = options_.verify_crcs ? std::min(at, crc_pos_) : at;
+    if (done_with >= released_ + kReleaseStepBytes) {
+      mapped_.release(static_cast<std::size_t>(released_), static_cast<std::size_t>(done_with));
+      released_ = done_with;
+    }
     if (at >= file_.size()) {
       stop(at, "the file ends without a DataEnd record (cut short?)");
       return false;

@@ -163,6 +163,8 @@ class McapReader {
   bool decode_message(std::span<const std::byte> body, std::uint64_t offset, McapMessage& out);
 
   MappedFile mapped_;
+  /// the file before this offset was released from memory (next())
+  std::uint64_t released_ = 0;
   std::span<const std::byte> file_;
   std::string path_;
   McapReaderOptions options_;
