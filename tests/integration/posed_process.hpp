@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <optional>
@@ -59,6 +60,9 @@ class PosedProcess {
   PosedProcess(const std::vector<std::string>& argv, const std::vector<std::string>& env,
                const TempDir& dir, bool set_watchdog_pid = false)
       : stdout_path_(dir.file("stdout.txt")), stderr_path_(dir.file("stderr.txt")) {
+    // The child's freopen() flushes what it inherited in stdio's buffers to the test's own
+    // output: empty them first, or the test's lines appear once per child.
+    std::fflush(nullptr);
     pid_ = ::fork();
     if (pid_ == 0) {
       for (const auto& e : env) ::putenv(const_cast<char*>(e.c_str()));

@@ -9,8 +9,12 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <optional>
+#include <random>
 #include <thread>
 
 #include "drivers/recording/mcap_reader.hpp"
@@ -161,6 +165,84 @@ TEST(PosectlRecord, RecordsTheSourcesUntilSigintAndPosedReplaysTheFile) {
             static_cast<long long>(by_topic["/posed/raw/imu"].size()))
       << out;
   EXPECT_NE(out.find("lidar scans"), std::string::npos) << out;
+}
+
+TEST(PosedRecord, SigkillAtAnyMomentLeavesAFileThatReplaysToItsLastCompleteChunk) {
+  // posed --record killed without warning (power cut, OOM killer) at moments drawn from a fixed
+  // seed, start-up included: every file that exists reads up to its last complete chunk, says
+  // where it stops, loses at most about the recorder's flush interval (1 s) of data, and posed
+  // replays exactly what it holds. POSED_CRASH_KILLS sets how many moments (default 3; the issue
+  // asks for 20: POSED_CRASH_KILLS=20 build/tests/integration/hil_integration_tests
+  // --gtest_filter='PosedRecord.Sigkill*').
+  const char* kills_env = std::getenv("POSED_CRASH_KILLS");
+  const int kills = kills_env ? std::max(1, std::atoi(kills_env)) : 3;
+  std::mt19937 random(20261126);
+  std::uniform_real_distribution<double> moment_s(0.2, 4.0);
+  int files = 0;
+  for (int k = 0; k < kills; ++k) {
+    TempDir dir;
+    const std::string config =
+        dir.write("posed.yaml", dds_config(source_dir()) +
+                                    "imu:\n  source: synthetic\n"
+                                    "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n"
+                                    "estimator:\n  init_static_s: 0.5\n");
+    const std::string recording = dir.file("run.mcap");
+    const double kill_at_s = moment_s(random);
+    std::optional<std::chrono::steady_clock::time_point> recording_since;
+    std::chrono::steady_clock::time_point killed_at;
+    {
+      PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--record", recording},
+                         {}, dir);
+      const auto start = std::chrono::steady_clock::now();
+      const auto kill_at = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                       std::chrono::duration<double>(kill_at_s));
+      while (std::chrono::steady_clock::now() < kill_at) {
+        ASSERT_FALSE(posed.wait_for_exit(5ms).has_value()) << posed.err();
+        if (!recording_since && posed.err().find("recording raw streams") != std::string::npos) {
+          recording_since = std::chrono::steady_clock::now();
+        }
+      }
+      posed.signal(SIGKILL);
+      killed_at = std::chrono::steady_clock::now();
+      ASSERT_EQ(posed.wait_for_exit(5s), -1) << "killed at " << kill_at_s << " s";
+    }
+    SCOPED_TRACE("SIGKILL " + std::to_string(k + 1) + " at " + std::to_string(kill_at_s) + " s");
+    if (!std::filesystem::exists(recording)) {
+      std::printf("SIGKILL %d at %.2f s: no file yet (start-up)\n", k + 1, kill_at_s);
+      EXPECT_FALSE(recording_since.has_value()) << "posed said it recorded, and left no file";
+      continue;
+    }
+    ++files;
+    rec::McapReader reader;
+    std::string error;
+    ASSERT_TRUE(reader.open(recording, error)) << error;
+    std::size_t imu = 0;
+    rec::McapMessage m;
+    while (reader.next(m)) imu += m.channel->topic == "/posed/raw/imu";
+    EXPECT_FALSE(reader.complete()) << "no footer can have been written";
+    EXPECT_FALSE(reader.stop_reason().empty());
+    if (recording_since) {
+      // The synthetic A9 at 200 Hz; what the recorder held in its last second may be lost.
+      const double recorded_s = std::chrono::duration<double>(killed_at - *recording_since).count();
+      EXPECT_GE(static_cast<double>(imu), 200.0 * (recorded_s - 1.5))
+          << imu << " IMU frames in a file recorded for " << recorded_s << " s";
+      std::printf("SIGKILL %d at %.2f s: recording for %.2f s, %zu IMU frames (%.2f s) kept, %s\n",
+                  k + 1, kill_at_s, recorded_s, imu, static_cast<double>(imu) / 200.0,
+                  reader.stop_reason().c_str());
+    }
+    if (imu == 0) continue;  // killed before the first chunk was flushed: nothing to replay
+
+    TempDir replay_dir;
+    PosedProcess replay({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
+                         "--max-speed", "--wait-subscribers", "0"},
+                        {}, replay_dir);
+    ASSERT_EQ(replay.wait_for_exit(60s), 0) << replay.err();
+    EXPECT_EQ(number_after(replay.out(), "  imu                 "), static_cast<long long>(imu))
+        << replay.out();
+    EXPECT_NE(replay.err().find("recording damaged"), std::string::npos) << replay.err();
+  }
+  std::printf("%d of %d SIGKILLed recordings left a file; every one read to its last chunk\n",
+              files, kills);
 }
 
 TEST(PosectlRecord, DurationAndSplitSizeMakeSeveralCompleteFiles) {
