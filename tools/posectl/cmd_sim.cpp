@@ -10,10 +10,12 @@
 #include <fstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "daemon/config/config_loader.hpp"
 #include "drivers/recording/recorder.hpp"
 #include "tools/posectl/commands.hpp"
+#include "tools/sim/fault_sink.hpp"
 #include "tools/sim/rig_config.hpp"
 #include "tools/sim/scenarios.hpp"
 #include "tools/sim/simulator.hpp"
@@ -128,12 +130,27 @@ int run_sim(int argc, char** argv) {
                  "default: the config's thermal_camera.format")
       ->check(CLI::IsMember({"y8", "y16"}));
   app.add_flag("--no-noise", no_noise, "ideal sensors: no noise, jitter or dropouts");
+  std::vector<std::string> fault_texts;
+  app.add_option("--fault", fault_texts,
+                 "a sensor fault KIND@START+DURATION (seconds of true time), repeatable: " +
+                     sim::fault_kind_names() +
+                     " (tools/sim/fault_sink.hpp); listed in the recording's metadata");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  std::vector<sim::Fault> faults;
+  for (const std::string& text : fault_texts) {
+    sim::Fault f;
+    std::string e;
+    if (!sim::parse_fault(text, f, e)) {
+      std::fprintf(stderr, "posectl sim: --fault %s\n", e.c_str());
+      return 2;
+    }
+    faults.push_back(f);
+  }
   const config::LoadResult loaded = config::load_config_file(config_path);
   if (!loaded.ok()) {
     std::fprintf(stderr, "posectl sim: %s", loaded.error_text().c_str());
@@ -201,6 +218,12 @@ int run_sim(int argc, char** argv) {
     md["smoke_dense_to_s"] = exact(smoke.dense_to_s);
     md["smoke_extinction_per_m"] = exact(smoke.dense_extinction_per_m);
   }
+  if (!faults.empty()) {
+    // When each fault began and how long it lasted, in true time since the start [s].
+    std::string list;
+    for (const sim::Fault& f : faults) list += (list.empty() ? "" : ",") + sim::to_string(f);
+    ropt.metadata[std::string(sim::kSimMetadataName)]["faults"] = list;
+  }
   drivers::recording::Recorder recorder;
   if (!recorder.open(out_path, ropt, error)) {
     std::fprintf(stderr, "posectl sim: %s\n", error.c_str());
@@ -227,7 +250,14 @@ int run_sim(int argc, char** argv) {
                  duration_s, done_s / std::max(wall, 1e-9));
     return true;
   };
-  const bool ok = sim::run_simulation(rig, options, sink, summary, error, progress);
+  // The faults sit between the simulator and the file (seeded apart from the world's noise).
+  sim::FaultSink faulted(sink, faults, options.host_epoch_ns, seed ^ 0x9e3779b97f4a7c15ull);
+  sim::SimSink& out = faults.empty() ? static_cast<sim::SimSink&>(sink) : faulted;
+  bool ok = sim::run_simulation(rig, options, out, summary, error, progress);
+  if (ok && !faults.empty() && !faulted.finish()) {
+    ok = false;
+    error = "cannot write the recording";
+  }
   std::fprintf(stderr, "\n");
   const bool closed = recorder.close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -265,6 +295,19 @@ int run_sim(int argc, char** argv) {
       static_cast<unsigned long long>(counters.messages_written),
       static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",
       gt_path.c_str());
+  for (const sim::Fault& f : faults) std::printf("  fault %s\n", sim::to_string(f).c_str());
+  for (std::size_t i = 0; i < faulted.counts().size() && !faults.empty(); ++i) {
+    const sim::FaultCounts& c = faulted.counts()[i];
+    if (c.dropped + c.blanked + c.frozen + c.corrupted + c.duplicated + c.reordered == 0) continue;
+    const sim::SimStream& st = faulted.streams()[i];
+    std::printf(
+        "    %s/%u: %llu dropped, %llu blanked, %llu frozen, %llu corrupted, %llu duplicated, "
+        "%llu reordered\n",
+        st.name.c_str(), st.source_channel, static_cast<unsigned long long>(c.dropped),
+        static_cast<unsigned long long>(c.blanked), static_cast<unsigned long long>(c.frozen),
+        static_cast<unsigned long long>(c.corrupted), static_cast<unsigned long long>(c.duplicated),
+        static_cast<unsigned long long>(c.reordered));
+  }
   if (smoke.any()) {
     std::printf(
         "  visible degraded (smoke) from %.1f s to %.1f s, dense from %.1f s to %.1f s "

@@ -1,0 +1,242 @@
+#include "tools/sim/fault_sink.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+namespace posed::sim {
+
+namespace {
+
+constexpr FaultKind kKinds[] = {
+    FaultKind::kLidarOutage,  FaultKind::kImuGap,     FaultKind::kCameraBlackout,
+    FaultKind::kCameraFreeze, FaultKind::kThermalFfc, FaultKind::kCorruptBurst,
+    FaultKind::kDuplicate,    FaultKind::kReorder,
+};
+
+bool parse_seconds(std::string_view text, double& out) {
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), out);
+  return r.ec == std::errc{} && r.ptr == text.data() + text.size() && std::isfinite(out);
+}
+
+}  // namespace
+
+std::string_view to_string(FaultKind kind) {
+  switch (kind) {
+    case FaultKind::kLidarOutage:
+      return "lidar_outage";
+    case FaultKind::kImuGap:
+      return "imu_gap";
+    case FaultKind::kCameraBlackout:
+      return "camera_blackout";
+    case FaultKind::kCameraFreeze:
+      return "camera_freeze";
+    case FaultKind::kThermalFfc:
+      return "thermal_ffc";
+    case FaultKind::kCorruptBurst:
+      return "corrupt_burst";
+    case FaultKind::kDuplicate:
+      return "duplicate";
+    case FaultKind::kReorder:
+      return "reorder";
+  }
+  return "unknown";
+}
+
+std::string to_string(const Fault& fault) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%s@%g+%g", std::string(to_string(fault.kind)).c_str(),
+                fault.start_s, fault.duration_s);
+  return text;
+}
+
+std::string fault_kind_names() {
+  std::string names;
+  for (const FaultKind k : kKinds) names += (names.empty() ? "" : ", ") + std::string(to_string(k));
+  return names;
+}
+
+bool parse_fault(std::string_view text, Fault& out, std::string& error) {
+  const auto at = text.find('@');
+  const auto plus = text.find('+', at == std::string_view::npos ? 0 : at);
+  if (at == std::string_view::npos || plus == std::string_view::npos) {
+    error = "fault '" + std::string(text) + "': expected KIND@START+DURATION (seconds), e.g. " +
+            "lidar_outage@30+5";
+    return false;
+  }
+  const std::string_view name = text.substr(0, at);
+  bool known = false;
+  for (const FaultKind k : kKinds) {
+    if (to_string(k) == name) {
+      out.kind = k;
+      known = true;
+    }
+  }
+  if (!known) {
+    error = "fault '" + std::string(text) + "': unknown kind '" + std::string(name) +
+            "' (kinds: " + fault_kind_names() + ")";
+    return false;
+  }
+  if (!parse_seconds(text.substr(at + 1, plus - at - 1), out.start_s) || out.start_s < 0 ||
+      !parse_seconds(text.substr(plus + 1), out.duration_s) || out.duration_s <= 0) {
+    error = "fault '" + std::string(text) +
+            "': start and duration must be seconds, start >= 0 and duration > 0";
+    return false;
+  }
+  return true;
+}
+
+FaultSink::FaultSink(SimSink& inner, std::vector<Fault> faults, std::int64_t host_epoch_ns,
+                     std::uint64_t seed)
+    : inner_(inner), faults_(std::move(faults)), host_epoch_ns_(host_epoch_ns), random_(seed) {}
+
+int FaultSink::add_stream(const SimStream& stream) {
+  const int id = inner_.add_stream(stream);
+  if (id < 0) return id;
+  const auto n = static_cast<std::size_t>(id) + 1;
+  if (streams_.size() < n) {
+    streams_.resize(n);
+    counts_.resize(n);
+    last_frame_.resize(n);
+    held_.resize(n);
+  }
+  streams_[static_cast<std::size_t>(id)] = stream;
+  return id;
+}
+
+bool FaultSink::is_frame(int stream) const {
+  const SimStream& s = streams_[static_cast<std::size_t>(stream)];
+  return (s.name == "visible" || s.name == "thermal") && s.source_channel == 0;
+}
+
+bool FaultSink::applies(const Fault& f, int stream) const {
+  const SimStream& s = streams_[static_cast<std::size_t>(stream)];
+  switch (f.kind) {
+    case FaultKind::kLidarOutage:
+      return s.name == "lidar";
+    case FaultKind::kImuGap:
+      return s.name == "imu";
+    case FaultKind::kCameraBlackout:
+    case FaultKind::kCameraFreeze:
+      return is_frame(stream);
+    case FaultKind::kThermalFfc:
+      return s.name == "thermal" && s.source_channel == 0;
+    case FaultKind::kCorruptBurst:
+    case FaultKind::kDuplicate:
+    case FaultKind::kReorder:
+      return true;
+  }
+  return false;
+}
+
+bool FaultSink::write_raw(int stream, HostTime host_time, std::span<const std::byte> bytes) {
+  const auto i = static_cast<std::size_t>(stream);
+  if (stream < 0 || i >= streams_.size()) return inner_.write_raw(stream, host_time, bytes);
+  last_host_time_ = host_time;
+  const double t_s = static_cast<double>(host_time.ns - host_epoch_ns_) / 1e9;
+  FaultCounts& count = counts_[i];
+  bool drop = false, blank = false, freeze = false, corrupt = false, duplicate = false;
+  bool reorder = false;
+  for (const Fault& f : faults_) {
+    if (!f.active(t_s) || !applies(f, stream)) continue;
+    switch (f.kind) {
+      case FaultKind::kLidarOutage:
+      case FaultKind::kImuGap:
+        drop = true;
+        break;
+      case FaultKind::kCameraBlackout:
+        blank = true;
+        break;
+      case FaultKind::kCameraFreeze:
+      case FaultKind::kThermalFfc:
+        freeze = true;
+        break;
+      case FaultKind::kCorruptBurst:
+        corrupt = true;
+        break;
+      case FaultKind::kDuplicate:
+        duplicate = true;
+        break;
+      case FaultKind::kReorder:
+        reorder = true;
+        break;
+    }
+  }
+  if (drop) {
+    ++count.dropped;
+    return true;
+  }
+  std::vector<std::byte> out(bytes.begin(), bytes.end());
+  if (is_frame(stream)) {
+    if (freeze && !last_frame_[i].empty() && last_frame_[i].size() == out.size()) {
+      out = last_frame_[i];
+      ++count.frozen;
+    } else if (!freeze) {
+      last_frame_[i] = out;
+    }
+    if (blank) {
+      const std::string& format = streams_[i].wire_format;
+      if (format == "yuyv") {
+        for (std::size_t k = 0; k < out.size(); ++k)
+          out[k] = k % 2 == 0 ? std::byte{16} : std::byte{128};
+      } else {
+        // A covered thermal lens sees the cover: every pixel alike, at the frame's mean.
+        const std::size_t step = format == "y16" ? 2 : 1;
+        double sum = 0;
+        for (std::size_t k = 0; k + step <= out.size(); k += step) {
+          sum += step == 2 ? static_cast<double>(std::to_integer<unsigned>(out[k]) |
+                                                 std::to_integer<unsigned>(out[k + 1]) << 8)
+                           : static_cast<double>(std::to_integer<unsigned>(out[k]));
+        }
+        const auto mean = static_cast<unsigned>(sum / static_cast<double>(out.size() / step));
+        for (std::size_t k = 0; k + step <= out.size(); k += step) {
+          out[k] = static_cast<std::byte>(mean & 0xFF);
+          if (step == 2) out[k + 1] = static_cast<std::byte>(mean >> 8);
+        }
+      }
+      ++count.blanked;
+    }
+  }
+  if (corrupt && !out.empty()) {
+    std::uniform_int_distribution<std::size_t> where(0, out.size() - 1);
+    std::uniform_int_distribution<int> bit(0, 7);
+    for (std::size_t k = 0; k < std::max<std::size_t>(1, out.size() / 64); ++k) {
+      out[where(random_)] ^= static_cast<std::byte>(1u << bit(random_));
+    }
+    ++count.corrupted;
+  }
+  Held& held = held_[i];
+  if (reorder && !held.held) {
+    // Held back: it arrives after the next message of its stream.
+    held = {true, std::move(out)};
+    return true;
+  }
+  if (!inner_.write_raw(stream, host_time, out)) return false;
+  if (duplicate) {
+    if (!inner_.write_raw(stream, host_time, out)) return false;
+    ++count.duplicated;
+  }
+  if (held.held) {
+    held.held = false;
+    ++count.reordered;
+    // Late: stamped with the time it finally arrives.
+    if (!inner_.write_raw(stream, host_time, held.bytes)) return false;
+  }
+  return true;
+}
+
+bool FaultSink::write_ground_truth(HostTime stamp, const GroundTruthPose& pose) {
+  return inner_.write_ground_truth(stamp, pose);
+}
+
+bool FaultSink::finish() {
+  for (std::size_t i = 0; i < held_.size(); ++i) {
+    if (!held_[i].held) continue;
+    held_[i].held = false;
+    // After everything else: the sink takes host times in order.
+    if (!inner_.write_raw(static_cast<int>(i), last_host_time_, held_[i].bytes)) return false;
+  }
+  return true;
+}
+
+}  // namespace posed::sim
