@@ -36,6 +36,18 @@ struct FusionCounters {
   /// camera frames handed to the core, by CameraStream
   std::atomic<std::uint64_t> frames_fused[2] = {0, 0};
   std::atomic<EstimatorMode> mode{EstimatorMode::kAligning};
+  /// stamp of the newest measurement the core took: where the merge is (a replay's data clock)
+  /// [ns]
+  std::atomic<std::int64_t> newest_stamp_ns{0};
+  /// the newest stamp the core took per stream: imu, lidar (a scan's end), visible, thermal [ns].
+  /// A replay's stream health: merged in stamp order, a stream that fell silent shows as the
+  /// merge passing it by.
+  std::atomic<std::int64_t> newest_stamp_by_stream_ns[4] = {0, 0, 0, 0};
+  /// a replay's stream (imu, lidar, visible, thermal) is silent now: the merge has passed its
+  /// newest stamp by more than kStreamStaleAfter (in stamp order only: live, the host clock
+  /// judges); and how often it fell silent
+  std::atomic<bool> stream_silent[4] = {false, false, false, false};
+  std::atomic<std::uint64_t> silences[4] = {0, 0, 0, 0};
 
   void publish_figures(const FusionFigures& f) {
     std::lock_guard lock(mutex_);
@@ -104,6 +116,16 @@ class FusionStage {
   std::vector<NavState> outgoing_;
   /// the newest receive stamp of everything handed to the core (NavState::received)
   HostTime newest_received_;
+  /// the newest stamp the core took (FusionCounters::newest_stamp_ns)
+  HostTime newest_stamp_;
+  /// In stamp order, after the core took a sample of `stream` (0..3) at `stamp`: that stream is
+  /// heard again if it was silent, and every stream the merge has passed by by more than
+  /// kStreamStaleAfter falls silent; both logged with the data's time.
+  void watch_silence(std::size_t stream, HostTime stamp);
+  /// per stream: it has delivered at least one sample
+  bool heard_[4] = {false, false, false, false};
+  /// per stream: its newest stamp
+  HostTime stream_stamp_[4];
 };
 
 }  // namespace posed::pipeline

@@ -285,6 +285,19 @@ std::string Pipeline::estimator_description() const {
 PipelineStatus Pipeline::status() const {
   if (!started_) return {};
   const HostTime now = drivers::host_now();
+  // Health is judged on this host's clock live, on the data's in a replay: where the fusion
+  // core's merge in stamp order is, which trails every stage however far the queues let one
+  // stage read ahead, and which a silent stream's last stamp falls behind.
+  const HostTime health_now =
+      sources_.imu->live()
+          ? now
+          : HostTime::from_ns(fusion_counters_->newest_stamp_ns.load(std::memory_order_relaxed));
+  const auto consumed = [&](std::size_t stream) -> std::optional<HostTime> {
+    if (sources_.imu->live()) return std::nullopt;
+    return HostTime::from_ns(
+        fusion_counters_->newest_stamp_by_stream_ns[stream].load(std::memory_order_relaxed));
+  };
+  std::lock_guard health_lock(health_mutex_);
   PipelineStatus st;
   st.stamp = now;
   st.mode = fusion_counters_->mode.load();
@@ -294,13 +307,14 @@ PipelineStatus Pipeline::status() const {
 
   StreamStatus imu;
   imu.name = "imu";
-  fill_stream_status(imu, imu_counters_, *sources_.imu, now);
+  fill_stream_status(imu, imu_counters_, *sources_.imu, health_now, health_[0], consumed(0));
   st.streams.push_back(std::move(imu));
 
   if (sources_.lidar) {
     StreamStatus lidar;
     lidar.name = "lidar";
-    fill_stream_status(lidar, lidar_counters_, *sources_.lidar, now);
+    fill_stream_status(lidar, lidar_counters_, *sources_.lidar, health_now, health_[1],
+                       consumed(1));
     st.streams.push_back(std::move(lidar));
     st.lidar_scans = scan_counters_->scans.load();
     st.lidar_points = scan_counters_->points.load();
@@ -310,7 +324,8 @@ PipelineStatus Pipeline::status() const {
     if (!sources_.camera(s)) continue;
     StreamStatus camera;
     camera.name = std::string(to_string(s));
-    fill_stream_status(camera, camera_counters_[index_of(s)], *sources_.camera(s), now);
+    fill_stream_status(camera, camera_counters_[index_of(s)], *sources_.camera(s), health_now,
+                       health_[2 + index_of(s)], consumed(2 + index_of(s)));
     st.streams.push_back(std::move(camera));
     st.camera_frames_fused[index_of(s)] = fusion_counters_->frames_fused[index_of(s)].load();
   }

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -166,6 +167,9 @@ class Pipeline {
   Wakeup fusion_ready_;
   Wakeup state_ready_;
 
+  /// status(): each stream's health between reports (imu, lidar, visible, thermal)
+  mutable std::mutex health_mutex_;
+  mutable StreamHealthMemory health_[4];
   StreamCounters imu_counters_;
   StreamCounters lidar_counters_;
   StreamCounters camera_counters_[2];

@@ -18,8 +18,8 @@ ClockSyncStatus StreamCounters::clock() const {
 }
 
 void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
-                        const drivers::Source& source, HostTime now) {
-  const bool live = source.live();
+                        const drivers::Source& source, HostTime now, StreamHealthMemory& memory,
+                        std::optional<HostTime> newest_arrival) {
   out.received = counters.received.load(std::memory_order_relaxed);
   out.refused = source.counters().rejected;
   out.decoded = counters.decoded.load(std::memory_order_relaxed);
@@ -31,19 +31,43 @@ void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
   out.clock_drift_ppm = clock.drift_ppm;
   out.clock_jitter_ns = static_cast<double>(clock.jitter.ns);
   out.clock_uncertainty_ns = static_cast<double>(clock.uncertainty.ns);
-  // A replay's arrival times are the recording's, not this host's: silence means nothing there.
-  const bool stale = clock.samples == 0 || (live && now - clock.last_arrival > Duration::from_s(1));
+  const Duration silent = now - newest_arrival.value_or(clock.last_arrival);
+  const bool stale = clock.samples == 0 || silent > kStreamStaleAfter;
   out.clock_state =
       std::string(to_string(stale && clock.samples > 0 ? SyncState::kLost : clock.state));
+  const std::uint64_t bad = out.malformed + out.dropped;
+  if (bad > memory.bad) memory.bad_rose = now;
+  memory.bad = bad;
+  const bool recently_bad = memory.bad_rose && now - *memory.bad_rose <= kStreamDegradedFor;
   if (counters.device_lost.load(std::memory_order_relaxed)) {
     out.health = "device_lost";
   } else if (out.decoded == 0 || stale) {
     out.health = "no_data";
-  } else if (out.malformed > 0 || out.dropped > 0) {
+  } else if (recently_bad) {
     out.health = "degraded";
   } else {
     out.health = "ok";
   }
+  // Not the first data (no_data -> ok at start-up is no news), but every change after it. A
+  // replay's silences are logged by the fusion stage, exactly in the data's time (a report
+  // sampled on the wall clock can miss one: a replay catches up on a silence at once).
+  const bool silence_change = out.health == "no_data" || memory.last_health == "no_data";
+  if (out.health != memory.last_health && memory.had_data && !(silence_change && newest_arrival)) {
+    // The journal's record of a stream failing and coming back, in the data's time.
+    char why[96] = "";
+    if (out.health == "no_data" && clock.samples > 0) {
+      std::snprintf(why, sizeof why, " (silent for %.2f s)", silent.seconds());
+    } else if (out.health == "degraded") {
+      std::snprintf(why, sizeof why, " (%llu malformed, %llu dropped so far)",
+                    static_cast<unsigned long long>(out.malformed),
+                    static_cast<unsigned long long>(out.dropped));
+    }
+    const log::Level level = out.health == "ok" ? log::Level::kNotice : log::Level::kWarning;
+    log::write(level, "stream %s: %s -> %s at %.3f s%s", out.name.c_str(),
+               memory.last_health.c_str(), out.health.c_str(), now.seconds(), why);
+  }
+  memory.last_health = out.health;
+  memory.had_data = memory.had_data || out.health == "ok" || out.health == "degraded";
 }
 
 bool SourceReader::next(drivers::RawChunk& chunk) {

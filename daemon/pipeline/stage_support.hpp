@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -80,11 +81,34 @@ struct StreamCounters {
   ClockSyncStatus clock_;
 };
 
-/// Fills `out` from the stage's counters and its Source's. A live Source's arrival times are on
-/// this host's clock, so a second of silence means the stream is lost whatever the clock
-/// estimate said last.
+/// What a stream's health is judged against between two reports (fill_stream_status()).
+struct StreamHealthMemory {
+  /// malformed + dropped at the last report
+  std::uint64_t bad = 0;
+  /// when that count last rose (unset: never)
+  std::optional<HostTime> bad_rose;
+  /// the health reported last, for the log's transitions ("" before the first report)
+  std::string last_health;
+  /// the stream was healthy (ok or degraded) at an earlier report: start-up is no news
+  bool had_data = false;
+};
+
+/// A stream is no_data once its newest sample is this much older than `now`.
+inline constexpr Duration kStreamStaleAfter = Duration::from_s(1);
+/// ... and degraded until this long after its malformed or dropped count last rose.
+inline constexpr Duration kStreamDegradedFor = Duration::from_s(2);
+
+/// Fills `out` from the stage's counters and its Source's, judging its health at `now`: this
+/// host's clock for a live Source, the newest sample of any stream in a replay (its data's
+/// clock, whatever the replay speed), so silence and bad samples mean the same in both.
+/// Health: device_lost; no_data (nothing decoded, or silent for kStreamStaleAfter); degraded
+/// (malformed or dropped samples within kStreamDegradedFor); ok. A change of health is logged.
+/// `newest_arrival`: the stream's newest stamp the fusion core took (a replay: the merge in stamp
+/// order waits for a silent stream, so only the merge passing it by shows the silence; `now` is
+/// then the merge's stamp); unset: its clock sync's newest arrival (live).
 void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
-                        const drivers::Source& source, HostTime now);
+                        const drivers::Source& source, HostTime now, StreamHealthMemory& memory,
+                        std::optional<HostTime> newest_arrival = std::nullopt);
 
 /// The bookkeeping every source stage does around Source::read(): heartbeat, the device lost and
 /// back (logged once per transition), the received count, and chunks of a wire format the stage

@@ -165,6 +165,57 @@ TEST(LioReplay, EveryLoopPassStartsAfreshAndRepeatsTheFirst) {
   }
 }
 
+TEST(LioReplay, ALidarOutageIsReportedInTheDataTimeAndTheOdometryCarriesOnThroughIt) {
+  // posectl sim --fault: the lidar falls silent for 2 s. posed keeps running and publishing
+  // odometry through it, logs the stream unhealthy about a second into the silence and healthy
+  // again when it speaks, in the data's time (at full speed too: the fusion stage judges a
+  // replay's silences as it merges the streams in stamp order).
+  TempDir dir;
+  const std::string recording = dir.file("street.mcap");
+  {
+    PosedProcess sim(
+        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night", "--duration",
+         "8", "--seed", "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
+         recording, "--fault", "lidar_outage@4+2"},
+        {}, dir);
+    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    EXPECT_NE(sim.out().find("fault lidar_outage@4+2"), std::string::npos) << sim.out();
+  }
+  const std::string config =
+      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
+                                  "\n  cyclonedds_config: " + source_dir() +
+                                  "/config/cyclonedds-loopback.xml\n");
+  PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
+                      "--max-speed", "--wait-subscribers", "0", "--record", dir.file("out.mcap")},
+                     {}, dir);
+  ASSERT_EQ(posed.wait_for_exit(120s), 0) << posed.err();
+  // posectl sim's host clock starts at 100 s (SimOptions::host_epoch_ns).
+  const auto at = [&](const std::string& change) -> double {
+    const std::string log = posed.err();
+    const auto i = log.find("stream lidar: " + change + " at ");
+    if (i == std::string::npos) return -1;
+    return std::stod(log.substr(i + 18 + change.size())) - 100.0;
+  };
+  const double lost_s = at("ok -> no_data"), back_s = at("no_data -> ok");
+  // A second into the silence, and with the first scan after it (the data's time, exactly).
+  EXPECT_NEAR(lost_s, 5.0, 0.1) << posed.err();
+  EXPECT_GE(back_s, 5.95) << posed.err();
+  EXPECT_LE(back_s, 6.3) << posed.err();
+  EXPECT_EQ(posed.err().find("stream imu:"), std::string::npos) << posed.err();
+
+  // The odometry went on through the silence (IMU propagation).
+  const auto odom = recorded_poses(dir.file("out.mcap"), "/posed/odom", true);
+  const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
+  ASSERT_FALSE(truth.empty());
+  const std::int64_t start_ns = truth.begin()->first;
+  std::size_t during = 0;
+  for (const auto& [stamp, p] : odom) {
+    const double t = static_cast<double>(stamp - start_ns) * 1e-9;
+    during += t > 4.2 && t < 5.8;
+  }
+  EXPECT_GT(during, 150u) << "IMU-rate odometry (150 Hz) through the 2 s outage";
+}
+
 /// A whole file's bytes.
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
