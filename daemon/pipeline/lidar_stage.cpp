@@ -48,6 +48,17 @@ LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration 
                pool_) {}
 
 void LidarStage::push_scan(LidarScan&& scan) {
+  const Duration off = scan.end_stamp - chunk_received_;
+  if (chunk_received_.ns != 0 && (off > kMaxScanStampToArrival || off < -kMaxScanStampToArrival)) {
+    if (scan_counters_.implausible.fetch_add(1, std::memory_order_relaxed) == 0) {
+      POSED_LOG_WARN(
+          "lidar: scan stamped %.3f s from its arrival left out (a corrupt device "
+          "time?); such scans are counted as dropped",
+          off.seconds());
+    }
+    counters_.dropped.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
   scan_counters_.scans.fetch_add(1, std::memory_order_relaxed);
   scan_counters_.points.fetch_add(scan.point_count, std::memory_order_relaxed);
   const PushResult r = queue_.push(ScanItem{std::move(scan), false, chunk_received_});

@@ -23,7 +23,16 @@ namespace posed::pipeline {
 struct LidarScanCounters {
   std::atomic<std::uint64_t> scans{0};   ///< scans assembled
   std::atomic<std::uint64_t> points{0};  ///< points in those scans
+  /// scans left out: stamped further from their arrival than kMaxScanStampToArrival (a corrupt
+  /// device time the clock sync followed); counted as dropped too
+  std::atomic<std::uint64_t> implausible{0};
 };
+
+/// A scan's end stamp and the arrival of the packet that closed it are a few ms apart (the
+/// transport, plus a lost last packet or two); a second means the stamp is wrong. Handed on, a
+/// scan stamped in the future would hold the fusion stage's stamp-ordered merge of the lidar
+/// for as long (every later scan waits behind it).
+inline constexpr Duration kMaxScanStampToArrival = Duration::from_s(1);
 
 class LidarStage {
  public:

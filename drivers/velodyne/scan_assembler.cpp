@@ -81,6 +81,13 @@ void ScanAssembler::add(const DecodedPacket& packet, DeviceTime packet_time) {
   std::uint32_t missing = 0;
   if (have_packet_) {
     const std::int64_t dt = packet_time.ns - last_packet_time_.ns;
+    if (dt == 0) {
+      // The same device time again: a duplicated datagram, or one that arrived after its
+      // successor (ScanBuilder stamps packets with the newest device time). Its firings would
+      // run backwards through the open scan and cut it at every packet: left out, counted.
+      ++counters_.repeated_packets;
+      return;
+    }
     if (dt < 0) {
       ++counters_.time_jumps;
       close(false);

@@ -67,6 +67,9 @@ struct ScanAssemblerCounters {
   std::uint64_t missing_packets = 0;
   /// device time went backwards (sensor restart, recording spliced)
   std::uint64_t time_jumps = 0;
+  /// packets left out because their device time was the previous packet's (a duplicated
+  /// datagram, or a late one stamped with the newest device time by ScanBuilder)
+  std::uint64_t repeated_packets = 0;
 };
 
 class ScanAssembler {

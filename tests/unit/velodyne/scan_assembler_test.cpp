@@ -192,6 +192,26 @@ TEST(ScanAssembler, OutageLongerThanATurnStillCuts) {
   }
 }
 
+TEST(ScanAssembler, ARepeatedPacketIsLeftOutInsteadOfCuttingTheScan) {
+  // A duplicated datagram (or a late one, stamped with the newest device time): its firings
+  // would run backwards through the open scan and cut it at every repeat.
+  PayloadPool pool(8, kScanBytes);
+  auto packets = rotation(400, 0x37);
+  const Assembly clean = assemble(packets, 0, pool);
+  std::vector<std::vector<std::byte>> doubled;
+  for (std::size_t i = 0; i < packets.size(); ++i) {
+    doubled.push_back(packets[i]);
+    if (i >= 100 && i < 250) doubled.push_back(packets[i]);  // every packet of a turn twice
+  }
+  const Assembly run = assemble(doubled, 0, pool);
+  ASSERT_EQ(run.scans.size(), clean.scans.size());
+  EXPECT_EQ(run.counters.repeated_packets, 150u);
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    EXPECT_EQ(run.scans[i].scan.point_count, clean.scans[i].scan.point_count) << "scan " << i;
+    EXPECT_EQ(run.scans[i].info.complete(), clean.scans[i].info.complete()) << "scan " << i;
+  }
+}
+
 TEST(ScanAssembler, DualReturns) {
   PayloadPool pool(8, 2 * kScanBytes);
   const auto packets = rotation(700, 0x39);  // 300 packets per turn in dual mode
