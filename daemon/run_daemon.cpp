@@ -1,5 +1,6 @@
 #include "daemon/run_daemon.hpp"
 
+#include <malloc.h>
 #include <signal.h>
 
 #include <algorithm>
@@ -351,7 +352,13 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
       exit_code = 1;
       break;
     }
-    // The last pass's pipeline, with its Sources, goes when the next one replaces it.
+    // The last pass's pipeline, with its Sources, goes before the next one is built, and the
+    // heap it freed goes back to the system: glibc keeps freed memory in its arenas, and the
+    // next pass's threads and allocations rarely fit the same holes, so without the trim
+    // resident memory grows by ~15 MB a pass although nothing leaks (heaptrack: the heap in
+    // use is the same every pass).
+    pipe.reset();
+    ::malloc_trim(0);
     built = std::move(replay.built);
     replayers = std::move(replay.replayers);
     if (recorder) pipeline::tap_sources(built.sources, *recorder, config);
