@@ -16,7 +16,10 @@ constexpr std::uint32_t tag_of(std::uint64_t head) {
 
 PayloadPool::PayloadPool(std::size_t buffer_count, std::size_t buffer_bytes)
     : buffer_bytes_(buffer_bytes),
-      storage_(std::make_unique<std::byte[]>(buffer_count * buffer_bytes)),
+      // Not zeroed: a buffer's pages become resident when first written, so spare buffers (the
+      // lidar's cover the worst case, docs/faults.md) cost address space, not memory. A reused
+      // buffer holds its last payload anyway: nobody may read what it did not write.
+      storage_(std::make_unique_for_overwrite<std::byte[]>(buffer_count * buffer_bytes)),
       next_(buffer_count),
       head_(pack(buffer_count == 0 ? kNone : 0, 0)) {
   for (std::size_t i = 0; i < buffer_count; ++i) {

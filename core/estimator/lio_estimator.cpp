@@ -44,7 +44,7 @@ LioEstimator::LioEstimator(const LioConfig& config)
       moving_alignment_(imu::MovingAlignmentConfig{.gravity_mps2 = config.gravity_mps2}),
       // 20 s at 200 Hz: room for the lag of the slowest scan and a stalled consumer.
       imu_(ImuBufferConfig{.capacity = 4000}),
-      gate_(MeasurementGateConfig{.pending_capacity = 8}),
+      gate_(MeasurementGateConfig{.pending_capacity = kLidarScanGateCapacity}),
       lidar_(config.lidar),
       map_cloud_(config.map_voxel_m),
       window_(window_config(config)) {

@@ -50,6 +50,13 @@
 
 namespace posed {
 
+/// Scans the lidar-inertial estimator's gate holds at most. The lidar stage's scan buffers must
+/// outnumber these plus its queue: while the gate holds scans waiting for the IMU, the fusion
+/// stage's stamp-ordered merge waits for the lidar's next scan, which needs a free buffer; with
+/// every buffer held the lidar stopped for good (a burst of corrupt packets cut many tiny
+/// scans: docs/faults.md).
+inline constexpr std::size_t kLidarScanGateCapacity = 8;
+
 /// What a gate does with a measurement older than the last one it released.
 enum class LatePolicy : std::uint8_t {
   kDrop,    ///< discard it, counted (late_dropped)

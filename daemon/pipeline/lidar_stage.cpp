@@ -1,5 +1,6 @@
 #include "daemon/pipeline/lidar_stage.hpp"
 
+#include "core/sync/measurement_gate.hpp"
 #include "daemon/pipeline/thread_policy.hpp"
 #include "drivers/common/log.hpp"
 #include "drivers/common/wire_format.hpp"
@@ -19,7 +20,9 @@ std::vector<double> LidarStage::ring_elevations(const velodyne::Calibration& cal
 }
 
 std::size_t LidarStage::pool_buffers(const config::PosedConfig& config) {
-  return static_cast<std::size_t>(config.queues.scan_capacity) + 4;
+  // The queue, the estimator's gate, the fusion stage's look-ahead, the scan being assembled,
+  // and one to spare: however the others fill, the next scan has a buffer.
+  return static_cast<std::size_t>(config.queues.scan_capacity) + kLidarScanGateCapacity + 3;
 }
 
 LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration calibration,
