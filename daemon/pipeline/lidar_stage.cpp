@@ -81,11 +81,25 @@ void LidarStage::forward_scans() {
 }
 
 void LidarStage::handle_position(const drivers::RawChunk& chunk) {
-  // The PPS state says whether the µs-past-the-hour is GPS-aligned.
-  if (builder_.add_position(chunk.bytes) && !reported_pps_) {
-    POSED_LOG_INFO("lidar: PPS locked, device time is GPS-aligned");
-    reported_pps_ = true;
+  // The PPS state says whether the µs-past-the-hour is GPS-aligned. Without PPS the lidar's
+  // clock free-runs on its crystal and steps back when it re-locks; the clock sync follows both,
+  // the log says when.
+  const auto pps = builder_.add_position(chunk.bytes);
+  if (!pps) return;
+  const bool locked = *pps == velodyne::PpsStatus::kLocked;
+  if (locked && !pps_locked_) {
+    if (pps_lost_at_) {
+      POSED_LOG_INFO("lidar: PPS locked again after %.1f s, device time is GPS-aligned",
+                     (chunk.host_receive - *pps_lost_at_).seconds());
+    } else {
+      POSED_LOG_INFO("lidar: PPS locked, device time is GPS-aligned");
+    }
+  } else if (!locked && pps_locked_) {
+    POSED_LOG_WARN("lidar: PPS lost (status %s), device time free-runs until it re-locks",
+                   std::string(velodyne::to_string(*pps)).c_str());
+    pps_lost_at_ = chunk.host_receive;
   }
+  pps_locked_ = locked;
 }
 
 void LidarStage::handle_data(const drivers::RawChunk& chunk) {

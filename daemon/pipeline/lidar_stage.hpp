@@ -5,6 +5,7 @@
 // bag (sensor_msgs/PointCloud2) become scans directly (lidar_stage_ros1.cpp).
 
 #include <memory>
+#include <optional>
 
 #include "core/payload_pool.hpp"
 #include "core/spsc_queue.hpp"
@@ -73,7 +74,10 @@ class LidarStage {
   ClockSyncStatus cloud_clock_;
   bool reported_cloud_layout_ = false;
   drivers::velodyne::AssembledScan assembled_;
-  bool reported_pps_ = false;
+  /// the newest position packet said the PPS is locked
+  bool pps_locked_ = false;
+  /// the receive time of the position packet that first said the PPS was lost
+  std::optional<HostTime> pps_lost_at_;
   /// the Source's receive stamp of the chunk being handled (a scan's is its last packet's)
   HostTime chunk_received_;
 };

@@ -8,12 +8,6 @@
 namespace posed::drivers::velodyne {
 namespace {
 
-constexpr std::size_t kPositionTimestampOffset = 198;
-constexpr std::size_t kPpsOffset = 202;
-constexpr std::size_t kNmeaOffset = 206;
-constexpr std::size_t kNmeaBytes = 128;
-constexpr std::uint32_t kUsPerHour = 3'600'000'000u;
-
 int hex_digit(char c) {
   if (c >= '0' && c <= '9') return c - '0';
   if (c >= 'A' && c <= 'F') return c - 'A' + 10;

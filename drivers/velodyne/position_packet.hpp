@@ -20,6 +20,12 @@
 namespace posed::drivers::velodyne {
 
 inline constexpr std::size_t kPositionPacketBytes = 512;
+inline constexpr std::size_t kPositionTimestampOffset = 198;
+inline constexpr std::size_t kPpsOffset = 202;
+inline constexpr std::size_t kNmeaOffset = 206;
+inline constexpr std::size_t kNmeaBytes = 128;
+/// the period of the µs-past-the-hour stamps [µs]
+inline constexpr std::uint32_t kUsPerHour = 3'600'000'000u;
 
 enum class PpsStatus : std::uint8_t {
   kAbsent = 0,

@@ -25,10 +25,10 @@ DecodeStatus ScanBuilder::add_data(std::span<const std::byte> payload, HostTime 
   return status;
 }
 
-bool ScanBuilder::add_position(std::span<const std::byte> payload) {
+std::optional<PpsStatus> ScanBuilder::add_position(std::span<const std::byte> payload) {
   PositionPacket position;
-  return parse_position_packet(payload, position) != PositionStatus::kWrongSize &&
-         position.pps == PpsStatus::kLocked;
+  if (parse_position_packet(payload, position) == PositionStatus::kWrongSize) return std::nullopt;
+  return position.pps;
 }
 
 }  // namespace posed::drivers::velodyne

@@ -5,6 +5,7 @@
 // their host arrival times; no clock is read, no I/O.
 
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "core/payload_pool.hpp"
@@ -30,8 +31,9 @@ class ScanBuilder {
   /// One data-port payload received at `arrival`; kOk when it was decoded (scans that it
   /// completed are then ready in pop()).
   DecodeStatus add_data(std::span<const std::byte> payload, HostTime arrival);
-  /// One position-port payload: true when it says the PPS is locked (GPS-aligned device time).
-  bool add_position(std::span<const std::byte> payload);
+  /// One position-port payload: its PPS status (locked: device time is GPS-aligned); nullopt
+  /// when it is not a position packet.
+  std::optional<PpsStatus> add_position(std::span<const std::byte> payload);
   /// The next finished scan, oldest first.
   bool pop(AssembledScan& out) { return assembler_.pop(out); }
   /// End of stream: closes the scan in progress (then available from pop()).

@@ -298,15 +298,18 @@ int run_sim(int argc, char** argv) {
   for (const sim::Fault& f : faults) std::printf("  fault %s\n", sim::to_string(f).c_str());
   for (std::size_t i = 0; i < faulted.counts().size() && !faults.empty(); ++i) {
     const sim::FaultCounts& c = faulted.counts()[i];
-    if (c.dropped + c.blanked + c.frozen + c.corrupted + c.duplicated + c.reordered == 0) continue;
+    if (c.dropped + c.blanked + c.frozen + c.corrupted + c.duplicated + c.reordered + c.restamped ==
+        0) {
+      continue;
+    }
     const sim::SimStream& st = faulted.streams()[i];
     std::printf(
         "    %s/%u: %llu dropped, %llu blanked, %llu frozen, %llu corrupted, %llu duplicated, "
-        "%llu reordered\n",
+        "%llu reordered, %llu restamped\n",
         st.name.c_str(), st.source_channel, static_cast<unsigned long long>(c.dropped),
         static_cast<unsigned long long>(c.blanked), static_cast<unsigned long long>(c.frozen),
         static_cast<unsigned long long>(c.corrupted), static_cast<unsigned long long>(c.duplicated),
-        static_cast<unsigned long long>(c.reordered));
+        static_cast<unsigned long long>(c.reordered), static_cast<unsigned long long>(c.restamped));
   }
   if (smoke.any()) {
     std::printf(

@@ -17,8 +17,14 @@
 //   corrupt_burst    every stream's messages get random bytes flipped (1 in 64, seeded)
 //   duplicate        every message is delivered twice
 //   reorder          each stream's messages arrive in swapped pairs (the later one first)
+//   imu_reset        the A9 reboots: silent for the window, then its µs counter restarts from
+//                    where a counter started at the window's beginning would be (CRC redone)
+//   pps_loss         the lidar loses its PPS: for the window, position packets say "absent" and
+//                    the device clock free-runs kFreeRunPpm fast; at the end it re-locks and its
+//                    time steps back onto the PPS-aligned line
 
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <string>
 #include <string_view>
@@ -37,7 +43,12 @@ enum class FaultKind {
   kCorruptBurst,
   kDuplicate,
   kReorder,
+  kImuReset,
+  kPpsLoss,
 };
+
+/// How fast the lidar's clock runs without PPS (its crystal, a VLP-32C-class part) [ppm]
+inline constexpr double kFreeRunPpm = 100.0;
 
 struct Fault {
   FaultKind kind = FaultKind::kLidarOutage;
@@ -64,6 +75,8 @@ struct FaultCounts {
   std::uint64_t corrupted = 0;
   std::uint64_t duplicated = 0;
   std::uint64_t reordered = 0;
+  /// messages whose device time the fault rewrote (imu_reset, pps_loss)
+  std::uint64_t restamped = 0;
 };
 
 class FaultSink : public SimSink {
@@ -89,6 +102,10 @@ class FaultSink : public SimSink {
   };
   bool is_frame(int stream) const;
   bool applies(const Fault& f, int stream) const;
+  /// imu_reset: the A9 frame's counter minus every restart behind `t_s`; false if unchanged.
+  bool restart_counter(double t_s, std::vector<std::byte>& frame);
+  /// pps_loss: the lidar packet's µs past the hour free-running, PPS status absent.
+  bool free_run(double t_s, int stream, std::vector<std::byte>& packet) const;
 
   SimSink& inner_;
   std::vector<Fault> faults_;
@@ -101,6 +118,8 @@ class FaultSink : public SimSink {
   /// per stream: a message reorder holds back until the next one
   std::vector<Held> held_;
   HostTime last_host_time_;
+  /// per fault: imu_reset's counter at the reboot (the first frame it silenced) [µs]
+  std::vector<std::optional<std::uint32_t>> reset_counter_us_;
 };
 
 }  // namespace posed::sim

@@ -16,10 +16,10 @@ void put_u32(std::byte* p, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) p[k] = static_cast<std::byte>((v >> (8 * k)) & 0xFF);
 }
 
-constexpr std::size_t kPositionTimestampOffset = 198;
-constexpr std::size_t kPpsOffset = 202;
-constexpr std::size_t kNmeaOffset = 206;
-constexpr std::size_t kNmeaBytes = 128;
+using vel::kNmeaBytes;
+using vel::kNmeaOffset;
+using vel::kPositionTimestampOffset;
+using vel::kPpsOffset;
 
 /// "ddmm.mmmm" with `deg_digits` degree digits.
 std::string nmea_coordinate(double deg, int deg_digits) {

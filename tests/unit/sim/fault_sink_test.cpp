@@ -7,6 +7,11 @@
 
 #include <algorithm>
 
+#include "drivers/imu/a9_protocol.hpp"
+#include "drivers/velodyne/packet_format.hpp"
+#include "drivers/velodyne/position_packet.hpp"
+#include "tools/sim/vlp32c_encoder.hpp"
+
 namespace posed::sim {
 namespace {
 
@@ -133,6 +138,95 @@ TEST(FaultSink, DuplicatesAndReordersKeepHostTimesInOrder) {
   for (std::size_t k = 1; k < reorder.memory.messages.size(); ++k) {
     EXPECT_GE(reorder.memory.messages[k].host_time.ns, reorder.memory.messages[k - 1].host_time.ns);
   }
+}
+
+namespace a9 = drivers::a9;
+namespace vel = drivers::velodyne;
+
+/// A9 sensor frames at 100 Hz for 3 s whose counter reads 4'000'000'000 µs + true time (it wraps
+/// during the run), through a FaultSink; the counters of the frames that come out, by time.
+std::vector<std::pair<double, std::uint32_t>> a9_counters_after(std::vector<Fault> faults) {
+  MemorySink memory;
+  FaultSink sink(memory, std::move(faults), kEpochNs, 1);
+  const int imu = sink.add_stream({"imu", "a9-serial", 0, {}});
+  std::vector<std::uint8_t> frame(a9::kSensorFrameSize);
+  for (int k = 0; k < 300; ++k) {
+    a9::A9SensorFrame f;
+    f.counter_us = 4'000'000'000u + static_cast<std::uint32_t>(k) * 10'000u;
+    EXPECT_EQ(a9::encode_a9_sensor_frame(f, frame), frame.size());
+    const auto* b = reinterpret_cast<const std::byte*>(frame.data());
+    EXPECT_TRUE(sink.write_raw(imu, at(k * 0.01), {b, frame.size()}));
+  }
+  std::vector<std::pair<double, std::uint32_t>> out;
+  for (const auto& m : memory.messages) {
+    a9::A9Decoder decoder;
+    std::span<const std::uint8_t> input(reinterpret_cast<const std::uint8_t*>(m.bytes.data()),
+                                        m.bytes.size());
+    a9::A9Frame decoded;
+    EXPECT_EQ(decoder.next(input, decoded), a9::DecodeStatus::kFrame) << "the CRC still holds";
+    out.emplace_back(static_cast<double>(m.host_time.ns - kEpochNs) * 1e-9,
+                     decoded.sensor.counter_us);
+  }
+  return out;
+}
+
+TEST(FaultSink, AnImuResetSilencesTheA9ThenRestartsItsCounterFromTheReboot) {
+  const auto frames = a9_counters_after({{FaultKind::kImuReset, 1.0, 0.5}});
+  ASSERT_EQ(frames.size(), 300u - 50u);
+  for (const auto& [t, counter] : frames) {
+    EXPECT_FALSE(t >= 1.0 - 1e-9 && t < 1.5 - 1e-9) << "rebooting at " << t;
+    // Before: untouched. After: µs since the reboot at 1.0 s.
+    const double expected_us = t < 1.0 ? 4e9 + t * 1e6 : (t - 1.0) * 1e6;
+    EXPECT_NEAR(static_cast<double>(counter), expected_us, 1.0) << t;
+  }
+}
+
+TEST(FaultSink, APpsLossLetsTheLidarClockRunFastThenStepBackAtTheRelock) {
+  MemorySink memory;
+  FaultSink sink(memory, {{FaultKind::kPpsLoss, 1.0, 2.0}}, kEpochNs, 1);
+  const int data = sink.add_stream({"lidar", "velodyne-udp-data", 0, {}});
+  const int position = sink.add_stream({"lidar", "velodyne-udp-position", 1, {}});
+  const int imu = sink.add_stream({"imu", "a9-serial", 0, {}});
+  // µs past the hour: 3599 s into the hour, so the free-running clock crosses the hour.
+  const auto stamp_us = [](int k) {
+    return 3'599'000'000u + static_cast<std::uint32_t>(k) * 1000u;
+  };
+  for (int k = 0; k < 4000; ++k) {
+    std::vector<std::byte> packet(vel::kDataPacketBytes);
+    for (std::size_t b = 0; b < 4; ++b) {
+      packet[vel::kTimestampOffset + b] =
+          static_cast<std::byte>(((stamp_us(k) % vel::kUsPerHour) >> (8 * b)) & 0xFF);
+    }
+    EXPECT_TRUE(sink.write_raw(data, at(k * 0.001), packet));
+    if (k % 100 == 0) {
+      std::vector<std::byte> pos(vel::kPositionPacketBytes);
+      encode_position_packet(stamp_us(k) % vel::kUsPerHour, vel::PpsStatus::kLocked, "", pos);
+      EXPECT_TRUE(sink.write_raw(position, at(k * 0.001), pos));
+      EXPECT_TRUE(sink.write_raw(imu, at(k * 0.001), pos));
+    }
+  }
+  std::size_t n_data = 0;
+  for (const auto& m : memory.messages) {
+    const double t = static_cast<double>(m.host_time.ns - kEpochNs) * 1e-9;
+    const bool lost = t >= 1.0 - 1e-9 && t < 3.0 - 1e-9;
+    if (m.stream == data) {
+      std::uint32_t got = 0;
+      for (std::size_t b = 0; b < 4; ++b) {
+        got |= std::to_integer<std::uint32_t>(m.bytes[vel::kTimestampOffset + b]) << (8 * b);
+      }
+      const double truth_us = static_cast<double>(stamp_us(static_cast<int>(n_data++)));
+      const double expected_us = lost ? truth_us + (t - 1.0) * kFreeRunPpm : truth_us;
+      EXPECT_NEAR(static_cast<double>(got), std::fmod(expected_us, 3.6e9), 1.0) << t;
+    } else {
+      vel::PositionPacket parsed;
+      vel::parse_position_packet(m.bytes, parsed);
+      const bool says_absent = parsed.pps == vel::PpsStatus::kAbsent;
+      EXPECT_EQ(says_absent, lost && m.stream == position) << "stream " << m.stream << " at " << t;
+    }
+  }
+  EXPECT_EQ(n_data, 4000u);
+  EXPECT_EQ(sink.counts()[static_cast<std::size_t>(data)].restamped, 2000u);
+  EXPECT_EQ(sink.counts()[static_cast<std::size_t>(imu)].restamped, 0u);
 }
 
 }  // namespace
