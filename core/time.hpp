@@ -3,6 +3,7 @@
 // A DeviceTime cannot be compared with a HostTime by accident: mapping one onto the other is
 // ClockSync's job, and converting to wall time happens only when a DDS message is stamped.
 
+#include <atomic>
 #include <compare>
 #include <cstdint>
 
@@ -68,11 +69,21 @@ using DeviceTime = TimePoint<DeviceClock>;
 using HostTime = TimePoint<HostClock>;
 using WallTime = TimePoint<WallClock>;
 
-/// The fixed offset between host monotonic and wall time, sampled once by the daemon (core never
-/// reads a clock). Applied when a DDS message is stamped.
+/// The offset between host monotonic and wall time, applied when a DDS message is stamped (core
+/// never reads a clock). Fixed (a recording's), or followed: a live daemon's WallClockFollower
+/// re-reads it and publishes it here when the wall clock steps (daemon/wall_clock_follower.hpp).
 struct HostToWall {
+  /// the offset, or the one at the start when followed
   Duration wall_minus_host;
-  constexpr WallTime operator()(HostTime t) const { return WallTime{t.ns + wall_minus_host.ns}; }
+  /// the followed offset [ns], when set (owned by the follower, which outlives every copy)
+  const std::atomic<std::int64_t>* followed_ns = nullptr;
+
+  Duration current() const {
+    return followed_ns ? Duration{followed_ns->load(std::memory_order_relaxed)} : wall_minus_host;
+  }
+  WallTime operator()(HostTime t) const { return WallTime{t.ns + current().ns}; }
+  /// The host time a stamp was made from (the inverse, with the offset of now).
+  HostTime to_host(WallTime t) const { return HostTime{t.ns - current().ns}; }
 };
 
 }  // namespace posed

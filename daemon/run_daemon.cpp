@@ -27,6 +27,7 @@
 #include "daemon/pipeline/source_factory.hpp"
 #include "daemon/pose_sinks.hpp"
 #include "daemon/run_summary.hpp"
+#include "daemon/wall_clock_follower.hpp"
 #include "drivers/camera/libusb_transport.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
@@ -137,8 +138,11 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   const HostTime started = drivers::host_now();
-  HostToWall to_wall{drivers::wall_now() - WallTime::from_ns(started.ns)};
+  // Live stamps stay on the wall clock through its steps (an NTP correction after boot).
+  WallClockFollower wall_clock(read_wall_minus_host);
+  HostToWall to_wall = wall_clock.to_wall();
   const bool replaying = !options.replay.path.empty();
+  const bool follow_wall_clock = !replaying || options.replay.live_stamps;
 
   dds::DdsConfig dds_config;
   dds_config.domain_id = static_cast<std::uint32_t>(config.dds.domain_id);
@@ -316,6 +320,14 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
         notifier.notify("STOPPING=1\nSTATUS=draining");
         stopping = true;
         pipe->request_stop();
+      }
+      if (follow_wall_clock) {
+        if (const std::optional<Duration> step = wall_clock.poll()) {
+          POSED_LOG_NOTICE(
+              "wall clock stepped by %+.3f s: DDS stamps follow it (the monotonic clock, and so "
+              "the estimate, did not move)",
+              step->seconds());
+        }
       }
       const std::vector<pipeline::StageBeat> beats = pipe->stage_heartbeats();
       for (std::size_t i = 0; i < watched.size() && i < beats.size(); ++i) {

@@ -146,7 +146,7 @@ bool Recorder::write_ros2(std::uint16_t channel, WallTime stamp, std::span<const
       channels_[channel]->kind != Kind::kRos2) {
     return false;
   }
-  return push(channel, stamp.ns - options_.host_to_wall.wall_minus_host.ns,
+  return push(channel, options_.host_to_wall.to_host(stamp).ns,
               std::vector<std::byte>(cdr.begin(), cdr.end()));
 }
 
@@ -173,7 +173,7 @@ bool Recorder::write_pose(std::string_view topic, WallTime stamp, std::string_vi
   ros2::StampedPose pose{stamp, std::string(frame), p_m, q_xyzw};
   std::vector<std::byte> cdr;
   ros2::encode_pose_stamped(pose, cdr);
-  return push(id, stamp.ns - options_.host_to_wall.wall_minus_host.ns, std::move(cdr));
+  return push(id, options_.host_to_wall.to_host(stamp).ns, std::move(cdr));
 }
 
 bool Recorder::write_odometry(std::string_view topic, WallTime stamp, std::string_view frame,
@@ -186,7 +186,7 @@ bool Recorder::write_odometry(std::string_view topic, WallTime stamp, std::strin
   ros2::StampedPose pose{stamp, std::string(frame), p_m, q_xyzw};
   std::vector<std::byte> cdr;
   ros2::encode_odometry(pose, child_frame, v_mps, w_radps, cdr);
-  return push(id, stamp.ns - options_.host_to_wall.wall_minus_host.ns, std::move(cdr));
+  return push(id, options_.host_to_wall.to_host(stamp).ns, std::move(cdr));
 }
 
 void Recorder::rotate() {

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "daemon/config/config_loader.hpp"
@@ -103,6 +104,52 @@ TEST(Daemon, PublishesOdomThatFollowsTheKnownMotionAndStopsOnSigterm) {
   EXPECT_EQ(*code, 0) << posed.err();
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
   EXPECT_NE(posed.out().find("posed summary"), std::string::npos) << posed.out();
+}
+
+// The host's wall clock steps (an NTP correction after boot; libfaketime steps the clock posed
+// sees, and only that one, leaving its monotonic clock alone): posed's DDS stamps follow the
+// wall clock within a poll of the main loop, and say so in the log. Before the step they agree
+// with this process's clock; after it, they are 30 s ahead of it, as posed's wall clock is.
+TEST(Daemon, StampsFollowAStepOfTheWallClock) {
+  const std::string faketime = "/usr/lib/x86_64-linux-gnu/faketime/libfaketime.so.1";
+  ASSERT_EQ(::access(faketime.c_str(), R_OK), 0)
+      << faketime << " is missing: tools/install-deps installs libfaketime";
+  TempDir dir;
+  const std::string config = dir.write("posed.yaml", demo_like_config());
+  const std::string offset_file = dir.write("faketime", "+0\n");
+  std::string error;
+  const std::array topics = {dds::Topic::kOdom};
+  auto reader = dds::Subscriber::create(reader_config(), topics, error);
+  ASSERT_TRUE(reader) << error;
+  PosedProcess posed(posed_argv(config),
+                     {"LD_PRELOAD=" + faketime, "FAKETIME_TIMESTAMP_FILE=" + offset_file,
+                      "FAKETIME_NO_CACHE=1", "FAKETIME_DONT_FAKE_MONOTONIC=1"},
+                     dir);
+  // Stamp minus receive time of the odometry taken within `for_s` [s], the newest last.
+  auto stamp_minus_receive_s = [&](double for_s) {
+    std::vector<dds::Received<dds::OdomMessage>> odom;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(for_s);
+    while (std::chrono::steady_clock::now() < until) {
+      reader->wait(Duration::from_ms(100));
+      reader->take_odom(odom);
+    }
+    std::vector<double> out;
+    for (const auto& r : odom) out.push_back((r.msg.stamp - r.received_wall).seconds());
+    return out;
+  };
+  const std::vector<double> before = stamp_minus_receive_s(3.0);
+  ASSERT_GE(before.size(), 50u) << "stderr:\n" << posed.err();
+  EXPECT_NEAR(before.back(), 0.0, 0.5);
+
+  // Replaced whole, so libfaketime never reads a half-written file.
+  ASSERT_EQ(std::rename(dir.write("faketime.new", "+30\n").c_str(), offset_file.c_str()), 0);
+  stamp_minus_receive_s(1.0);
+  const std::vector<double> after = stamp_minus_receive_s(2.0);
+  ASSERT_GE(after.size(), 50u) << "stderr:\n" << posed.err();
+  for (const double d : after) EXPECT_NEAR(d, 30.0, 0.5);
+  posed.signal(SIGTERM);
+  ASSERT_TRUE(posed.wait_for_exit(5s).has_value());
+  EXPECT_NE(posed.err().find("wall clock stepped by +30."), std::string::npos) << posed.err();
 }
 
 // What ROS 2 tools read: rt/tf carries map -> odom -> base_link with every pose, so the two
