@@ -118,7 +118,7 @@ TEST(UnitConfinement, AReplayWithEverySensorRunsWithSchedFifoAndTheSamePoses) {
 TEST(UnitConfinement, ALiveDriveOverUdpAndAPtyIsTracked) {
   std::string why;
   if (!can_sandbox(why)) GTEST_SKIP() << why;
-  hil_helpers::run_hil_drive({sandbox(), 6, {}});
+  hil_helpers::run_hil_drive({sandbox(), 6, {}, {}});
 }
 
 // The sandbox itself: a call the unit does not allow ends the process, as under systemd.

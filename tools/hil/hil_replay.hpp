@@ -12,6 +12,7 @@
 #include <mutex>
 #include <string>
 
+#include "tools/hil/hil_faults.hpp"
 #include "tools/hil/hil_playlist.hpp"
 #include "tools/hil/lateness_histogram.hpp"
 #include "tools/hil/pacer.hpp"
@@ -30,6 +31,8 @@ struct HilReplayOptions {
   /// the schedule's first message is due this long after run() starts sending, so setup costs
   /// do not show as lateness
   Duration lead = Duration::from_ms(100);
+  /// transport faults laid over what is sent (hil_faults.hpp)
+  std::vector<HilFault> faults;
 };
 
 /// Outputs, in the order of HilReplayStatus::lateness.
@@ -54,6 +57,7 @@ struct HilReplayStatus {
   std::int64_t end_log_ns = 0;
   std::uint64_t passes = 0;
   bool finished = false;
+  HilFaultCounts faults;
 };
 
 class HilReplay {
@@ -81,6 +85,11 @@ class HilReplay {
  private:
   static std::size_t slot(HilOutput output);
   void send(const HilMessage& m);
+  /// Sends `m` as the faults in force at `t_s` say (dropped, corrupted, twice, or held back).
+  void send_faulted(HilMessage& m, double t_s);
+  /// Unplugs or plugs the pty back in as the faults say at `t_s`; sends what a delay held back
+  /// once its window ended (all of it when `flush`).
+  void apply_faults(double t_s, bool flush);
 
   HilReplayOptions options_;
   HilPlaylist playlist_;
@@ -88,6 +97,12 @@ class HilReplay {
   std::unique_ptr<UdpEmitter> udp_;
   std::unique_ptr<PtyEmitter> pty_;
   std::atomic<bool> stop_{false};
+  HilFaults faults_;
+  /// log time of the first message sent: the faults' time origin [ns]
+  std::int64_t first_log_ns_ = 0;
+  /// messages a delay fault holds back, in order
+  std::vector<HilMessage> held_;
+  bool unplugged_ = false;
 
   mutable std::mutex mutex_;  // guards the fields below
   std::array<std::uint64_t, kHilOutputs.size()> messages_{};
@@ -97,6 +112,7 @@ class HilReplay {
   std::int64_t end_log_ns_ = 0;
   std::uint64_t passes_ = 0;
   bool finished_ = false;
+  HilFaultCounts fault_counts_;
 };
 
 }  // namespace posed::hil

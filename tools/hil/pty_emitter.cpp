@@ -17,7 +17,9 @@
 
 namespace posed::hil {
 
-PtyEmitter::~PtyEmitter() {
+PtyEmitter::~PtyEmitter() { close(); }
+
+void PtyEmitter::close() {
   if (linked_) {
     // Only our own link: another replay may have taken the path over since.
     std::array<char, 512> target{};
@@ -25,8 +27,10 @@ PtyEmitter::~PtyEmitter() {
     if (n > 0 && slave_path_ == std::string(target.data(), static_cast<std::size_t>(n))) {
       ::unlink(link_path_.c_str());
     }
+    linked_ = false;
   }
   if (master_ >= 0) ::close(master_);
+  master_ = -1;
 }
 
 bool PtyEmitter::open(std::string& error) {

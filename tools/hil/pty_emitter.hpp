@@ -38,6 +38,9 @@ class PtyEmitter {
   /// Creates the pty in raw mode and the symlink (atomically replacing an older symlink; a file
   /// or directory at the path is refused). false + `error` ("pty LINK: reason").
   bool open(std::string& error);
+  /// Closes the pty and removes the symlink, as a pulled USB adapter's device goes away: a reader
+  /// gets a hang-up. open() makes a new one at the same link.
+  void close();
   /// true while some process has the slave open.
   bool has_reader();
   /// Waits until has_reader(), `timeout` passes, or `stop` is set; returns has_reader().

@@ -71,6 +71,11 @@ int run_replay(int argc, char** argv) {
                  "driver under test first); 0 = start at once [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  std::vector<std::string> fault_texts;
+  app.add_option("--fault", fault_texts,
+                 "a transport fault KIND[:OUTPUT]@START+DURATION (seconds of the recording since "
+                 "its first message), repeatable: drop, corrupt, duplicate, delay, unplug (the "
+                 "pty); OUTPUT lidar, imu or all (tools/hil/hil_faults.hpp)");
   app.add_flag("--no-udp", no_udp, "do not send the lidar packets");
   app.add_flag("--no-pty", no_pty, "do not send the A9 stream");
   try {
@@ -93,6 +98,14 @@ int run_replay(int argc, char** argv) {
   options.playlist.loop = loop;
   options.playlist.udp = !no_udp;
   options.playlist.serial = !no_pty;
+  for (const std::string& text : fault_texts) {
+    hil::HilFault fault;
+    if (!hil::parse_hil_fault(text, fault, error)) {
+      std::fprintf(stderr, "posectl replay: --fault %s\n", error.c_str());
+      return 2;
+    }
+    options.faults.push_back(fault);
+  }
 
   // Before the sending thread exists, so it inherits the blocked mask.
   StopSignals signals;
@@ -255,6 +268,20 @@ int run_replay(int argc, char** argv) {
         "  time shift          %+.9f s: live wall time = recorded wall time + shift (first "
         "pass); posectl eval --offset %.9f compares live poses with the recording's truth\n",
         static_cast<double>(shift_ns) * 1e-9, -static_cast<double>(shift_ns) * 1e-9);
+  }
+  if (!options.faults.empty()) {
+    std::string listed;
+    for (const hil::HilFault& f : options.faults) {
+      listed += (listed.empty() ? "" : ", ") + hil::to_string(f);
+    }
+    std::printf(
+        "  faults              %s: %llu messages dropped, %llu corrupted, %llu duplicated, %llu "
+        "delayed; pty unplugged %llu times\n",
+        listed.c_str(), static_cast<unsigned long long>(s.faults.dropped),
+        static_cast<unsigned long long>(s.faults.corrupted),
+        static_cast<unsigned long long>(s.faults.duplicated),
+        static_cast<unsigned long long>(s.faults.delayed),
+        static_cast<unsigned long long>(s.faults.unplugged));
   }
   if (!replay.playlist().damage().empty()) {
     std::printf("  recording damaged   sent up to the damage: %s\n",
