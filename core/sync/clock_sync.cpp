@@ -37,6 +37,7 @@ void ClockSync::raise(ClockEvent e) {
     switch (ev) {
       case ClockEvent::kNone:
         return 0;
+      case ClockEvent::kOutlier:
       case ClockEvent::kCounterWrap:
       case ClockEvent::kHourRollover:
         return 1;
@@ -84,9 +85,16 @@ HostTime ClockSync::map_raw(std::uint64_t raw_stamp, HostTime host_arrival) {
     ++status_.rejected;
     return host_arrival - config_.latency;
   }
+  const CounterUnwrapper unwrapper_before = unwrapper_;
+  const HostTime stamp = map(u.stamp, host_arrival);
+  if (last_event_ == ClockEvent::kOutlier) {
+    // Not learnt from: the next sample unwraps against the last one on the line, so a corrupt
+    // stamp cannot move the counter into another period.
+    unwrapper_ = unwrapper_before;
+    return stamp;
+  }
   have_raw_ = true;
   last_raw_arrival_ = host_arrival;
-  const HostTime stamp = map(u.stamp, host_arrival);
   if (u.wrapped) {
     ++status_.wraps;
     raise(config_.kind == DeviceClockKind::kUsPastHour ? ClockEvent::kHourRollover
@@ -133,14 +141,29 @@ HostTime ClockSync::map(DeviceTime device_stamp, HostTime host_arrival) {
       restart(x, y);
     };
     bool restarted = false;
-    if (r < -threshold) {
-      // Below the envelope by more than any estimation error: device time leapt forward.
-      ++status_.jumps;
-      raise(ClockEvent::kJump);
-      restart(x, y);
-      restarted = true;
-    } else if (r > static_cast<double>(config_.max_transport_delay.ns)) {
-      discontinuity();
+    if (r < -threshold || r > static_cast<double>(config_.max_transport_delay.ns)) {
+      // Below the envelope by more than any estimation error (device time leapt forward), or
+      // above it by more than any delay (device time went back): a discontinuity once the
+      // samples after it agree on a new line, device time moving on; an outlier until then.
+      const bool agrees = outlier_run_ > 0 && x > outlier_device_ns_ &&
+                          std::abs(static_cast<double>(y - outlier_offset_ns_)) <= threshold;
+      if (!agrees) outlier_offset_ns_ = y;
+      outlier_run_ = agrees ? outlier_run_ + 1 : 1;
+      outlier_device_ns_ = x;
+      if (outlier_run_ < std::max<std::uint32_t>(config_.discontinuity_confirm_samples, 1)) {
+        ++status_.outliers;
+        raise(ClockEvent::kOutlier);
+        status_.last_arrival = host_arrival;
+        return host_arrival - config_.latency;
+      }
+      outlier_run_ = 0;
+      if (r < -threshold) {
+        ++status_.jumps;
+        raise(ClockEvent::kJump);
+        restart(x, y);
+      } else {
+        discontinuity();
+      }
       restarted = true;
     } else if (r > threshold) {
       ++high_run_;
@@ -153,6 +176,7 @@ HostTime ClockSync::map(DeviceTime device_stamp, HostTime host_arrival) {
       }
     } else {
       high_run_ = 0;
+      outlier_run_ = 0;
       if (status_.state == SyncState::kLost) {
         status_.state = SyncState::kLocked;
         raise(ClockEvent::kLocked);

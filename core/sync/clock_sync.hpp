@@ -22,11 +22,15 @@
 // feed it the high-rate stream and stamp the others with to_host(), which is more accurate
 // than fitting a 15 Hz stream on its own.
 //
-// Discontinuities: device time going backwards by more than `jump_threshold` is a reset; a
-// sample below the envelope by more than the threshold (impossible for a delay) is a forward
-// jump; `jump_confirm_samples` consecutive samples above it by more than the threshold are a
-// backward step. Each clears the envelope and re-converges (the drift estimate is kept, the
-// crystal did not change), is counted, and is reported once through last_event().
+// Discontinuities: a sample below the envelope by more than `jump_threshold` (impossible for a
+// delay) is a forward jump, one above it by more than `max_transport_delay` a reset (device time
+// went backwards) - once `discontinuity_confirm_samples` consecutive such samples agree with each
+// other on the new line. Until then each is an outlier: stamped from its arrival, counted,
+// reported as kOutlier, and not learnt from, so a corrupt stamp (bit flips in an unchecksummed
+// packet) costs one sample instead of the whole estimate. `jump_confirm_samples` consecutive
+// samples above the envelope by more than the threshold are a backward step. Each discontinuity
+// clears the envelope and re-converges (the drift estimate is kept, the crystal did not change),
+// is counted, and is reported once through last_event().
 //
 // Pure: no clock is read; the caller passes each sample's host arrival time.
 
@@ -88,6 +92,12 @@ class ClockSync {
   HostTime restarted_at_;
   /// consecutive samples far above the envelope [1]
   std::uint32_t high_run_ = 0;
+  /// consecutive outliers that agree on one line (a discontinuity being confirmed) [1]
+  std::uint32_t outlier_run_ = 0;
+  /// host minus device time of the first of them [ns]
+  std::int64_t outlier_offset_ns_ = 0;
+  /// device stamp of the newest of them [ns]
+  std::int64_t outlier_device_ns_ = 0;
   /// drift kept across restarts: the device's crystal does not change when it resets [1]
   double drift_ = 0.0;
   /// mean delay above the envelope, exponentially weighted [ns]

@@ -34,7 +34,9 @@ enum class ClockEvent : std::uint8_t {
   kCounterWrap,   ///< an N-bit device counter wrapped (expected, informational)
   kHourRollover,  ///< µs-past-the-hour rolled over (expected, informational)
   kReset,         ///< device time went backwards: device reset or restart; re-converging
-  kJump           ///< device time jumped against host time; re-converging
+  kJump,          ///< device time jumped against host time; re-converging
+  kOutlier,       ///< a stamp off the line by more than a delay can explain, not (yet) confirmed
+                  ///< by the samples after it: a corrupt stamp, or the first of a discontinuity
 };
 
 constexpr std::string_view to_string(DeviceClockKind k) {
@@ -79,6 +81,8 @@ constexpr std::string_view to_string(ClockEvent e) {
       return "reset";
     case ClockEvent::kJump:
       return "jump";
+    case ClockEvent::kOutlier:
+      return "outlier";
   }
   return "unknown";
 }
@@ -108,6 +112,10 @@ struct ClockSyncConfig {
   /// consecutive suspect samples that confirm a backward step of device time or a lasting
   /// change of latency (a single late sample is just a transport spike) [1]
   std::uint32_t jump_confirm_samples = 10;
+  /// consecutive samples, each off the line beyond any delay and agreeing with each other, that
+  /// confirm a reset or a forward jump; fewer are outliers (a corrupt stamp: an unchecksummed
+  /// lidar packet with flipped bits), stamped from their arrival and not learnt from [1]
+  std::uint32_t discontinuity_confirm_samples = 3;
   /// a sample above the envelope by more than this cannot be a transport delay: a reset (device
   /// time went backwards) or jump, declared at once without waiting for confirmation [ns]
   Duration max_transport_delay = Duration::from_ms(500);
@@ -149,6 +157,9 @@ struct ClockSyncStatus {
   std::uint64_t out_of_order = 0;
   /// samples rejected as bad input (raw stamp out of range, no device clock, too old) [1]
   std::uint64_t rejected = 0;
+  /// samples off the line beyond any delay that the samples after them did not confirm as a
+  /// discontinuity, plus those that led up to one (ClockEvent::kOutlier) [1]
+  std::uint64_t outliers = 0;
   /// transitions into kLocked [1]
   std::uint64_t locks = 0;
   /// frames inferred missing from the period (clockless streams only) [1]

@@ -42,6 +42,9 @@ void ImuStage::on_a9_frame(const a9::A9Frame& frame, HostTime arrival) {
   if (frame.kind != a9::FrameKind::kSensor) return;
   const HostTime stamp = clock_.map_raw(frame.sensor.counter_us, arrival);
   log_clock_event("imu", clock_.last_event());
+  // A counter the clock could not place (the first frames after a reboot, until they confirm
+  // it): left out, counted by the clock, rather than stamped off the device's time line.
+  if (clock_.last_event() == ClockEvent::kOutlier) return;
   const DeviceTime device_stamp = clock_.status().last_device_stamp;
   push(a9::to_imu_sample(frame.sensor, mounting_, stamp, device_stamp));
 }

@@ -119,7 +119,8 @@ DropPolicy queue_policy(const drivers::Source* source) {
 }
 
 void log_clock_event(std::string_view stream, ClockEvent event) {
-  if (event == ClockEvent::kNone) return;
+  // Outliers are counted (the clock's status), not logged: a corrupt burst has hundreds.
+  if (event == ClockEvent::kNone || event == ClockEvent::kOutlier) return;
   const bool bad =
       event == ClockEvent::kReset || event == ClockEvent::kJump || event == ClockEvent::kLost;
   log::write(bad ? log::Level::kWarning : log::Level::kInfo, "%.*s clock: %.*s",

@@ -18,6 +18,9 @@ DecodeStatus ScanBuilder::add_data(std::span<const std::byte> payload, HostTime 
   const DecodeStatus status = decoder_.decode(payload, *packet_);
   if (status != DecodeStatus::kOk) return status;
   const HostTime stamp = clock_.map_raw(packet_->device_time_us, arrival);
+  // A stamp the clock could not place (a corrupt one; the packet has no checksum) would put its
+  // points in another scan, or tear the one being assembled: left out, counted by the clock.
+  if (clock_.last_event() == ClockEvent::kOutlier) return status;
   const DeviceTime device_stamp = clock_.status().last_device_stamp;
   // The assembler stamps points as device time + this offset: ClockSync's mapping, per packet.
   assembler_.set_host_minus_device(stamp - HostTime::from_ns(device_stamp.ns));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <vector>
 
 #include "core/sync/simulated_clock.hpp"
@@ -248,6 +249,49 @@ TEST(ClockSync, BadInputIsCountedNotFatal) {
   EXPECT_EQ(odd.to_host(DeviceTime::from_ns(50'000'000)).ns, 50'000'500);
 }
 
+// Bit flips in an unchecksummed packet's stamp (a Velodyne data packet): single samples far off
+// the line, in both directions and in a burst, none of which the samples after them confirm. None
+// restarts the estimate; each is stamped from its arrival and reported as an outlier; every good
+// sample stays as accurate as without them.
+TEST(ClockSync, CorruptStampsAreOutliersNotResetsOrJumps) {
+  auto sim = harsh_stream(DeviceClockKind::kUsPastHour, 1507.0, 20.0, 31);
+  const auto clean = simulate_stream(sim, Duration::from_s(20));
+  std::vector<SimulatedSample> corrupt = clean;
+  std::mt19937_64 random(5);
+  std::vector<bool> flipped(corrupt.size(), false);
+  for (std::size_t i = 3000; i < corrupt.size(); ++i) {
+    // 1 in 200 samples, and a burst of 30 in a row at 12 s, get one of the stamp's bits flipped
+    const bool burst = i >= 18'000 && i < 18'030;
+    if (!burst && random() % 200 != 0) continue;
+    // 0.5 s to 18 min off: beyond any transport delay either way. (A flip of a few ms is
+    // indistinguishable from a late packet by timing alone and stays one.)
+    const auto bit = 19 + random() % 12;
+    corrupt[i].raw ^= 1ull << bit;
+    if (corrupt[i].raw >= 3'600'000'000ull) corrupt[i].raw %= 3'600'000'000ull;
+    flipped[i] = true;
+  }
+  ClockSync reference(config_for(sim)), sync(config_for(sim));
+  std::size_t flips = 0;
+  std::vector<double> extra_error_ns;
+  for (std::size_t i = 0; i < corrupt.size(); ++i) {
+    const HostTime good = reference.map_raw(clean[i].raw, clean[i].arrival);
+    const HostTime got = sync.map_raw(corrupt[i].raw, corrupt[i].arrival);
+    if (flipped[i]) {
+      ++flips;
+      EXPECT_EQ(sync.last_event(), ClockEvent::kOutlier) << i;
+      EXPECT_EQ(got, corrupt[i].arrival - sim.latency) << i;
+    } else if (i > 3000) {
+      extra_error_ns.push_back(std::abs(static_cast<double>((got - good).ns)));
+    }
+  }
+  EXPECT_GT(flips, 100u);
+  EXPECT_EQ(sync.status().resets, 0u);
+  EXPECT_EQ(sync.status().jumps, 0u);
+  EXPECT_EQ(sync.status().outliers, flips);
+  EXPECT_EQ(sync.status().state, SyncState::kLocked);
+  EXPECT_LT(percentile(extra_error_ns, 0.99), 20'000.0) << "[ns] against the uncorrupted run";
+}
+
 TEST(ClockSync, IsDeterministic) {
   const auto sim = harsh_stream(DeviceClockKind::kHardwareNs, 200.0, 30.0, 77);
   const auto samples = simulate_stream(sim, Duration::from_s(5));
@@ -272,8 +316,12 @@ TEST(ClockSync, AStragglerFromBeforeAResetIsStampedOnTheOldLineNotAnotherReset) 
     sync.map(DeviceTime::from_ns(t - 7'000'000'000), HostTime::from_ns(t + 1'000'000));
   }
   const std::int64_t reset_host = 11'000'000'000;
-  sync.map(DeviceTime::from_ns(0), HostTime::from_ns(reset_host + 1'000'000));
-  EXPECT_EQ(sync.last_event(), ClockEvent::kReset);
+  // The reset's first samples are outliers until the third confirms the new line.
+  for (std::int64_t k = 0; k < 3; ++k) {
+    sync.map(DeviceTime::from_ns(k * 5'000'000),
+             HostTime::from_ns(reset_host + 1'000'000 + k * 5'000'000));
+    EXPECT_EQ(sync.last_event(), k < 2 ? ClockEvent::kOutlier : ClockEvent::kReset) << k;
+  }
   // A sample taken just before the reset arrives 40 ms late.
   const std::int64_t late_truth = reset_host - 5'000'000;
   const HostTime late = sync.map(DeviceTime::from_ns(late_truth - 7'000'000'000),
@@ -281,7 +329,7 @@ TEST(ClockSync, AStragglerFromBeforeAResetIsStampedOnTheOldLineNotAnotherReset) 
   EXPECT_EQ(sync.last_event(), ClockEvent::kNone);
   // The old line (latency not configured here, so stamps sit 1 ms after the truth).
   EXPECT_NEAR(static_cast<double>(late.ns), static_cast<double>(late_truth + 1'000'000), 1'000.0);
-  sync.map(DeviceTime::from_ns(5'000'000), HostTime::from_ns(reset_host + 6'000'000));
+  sync.map(DeviceTime::from_ns(15'000'000), HostTime::from_ns(reset_host + 16'000'000));
   EXPECT_EQ(sync.last_event(), ClockEvent::kNone);
   EXPECT_EQ(sync.status().resets, 1u);
   EXPECT_EQ(sync.status().jumps, 0u);
