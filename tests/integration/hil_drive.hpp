@@ -59,7 +59,7 @@ inline void run_hil_drive(const HilDrive& drive, HilDriveResult* result_out = nu
   const std::string recording = dir.file("street.mcap");
   const std::string truth = dir.file("truth.tum");
   {
-    PosedProcess sim({posectl, "sim", "--scenario", "street_night", "--duration",
+    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration",
                       std::to_string(duration_s), "--seed", "8", "--no-cameras", "--config",
                       source_dir() + "/config/posed.yaml", "-o", recording, "--gt", truth},
                      {}, dir);

@@ -27,6 +27,14 @@ inline std::string build_dir() {
   return s ? s : POSED_BUILD_DIR_DEFAULT;
 }
 
+/// The posectl that simulates a test's input: this build's, or POSED_SIMULATOR's. The
+/// simulator makes the input, it is not under test; tools/sanitize-pipeline points this at a
+/// release build, since the renderer under ThreadSanitizer runs at a twentieth of real time.
+inline std::string simulator() {
+  const char* s = std::getenv("POSED_SIMULATOR");
+  return s ? s : build_dir() + "/tools/posectl/posectl";
+}
+
 /// A fresh directory under /tmp, removed with its files when the object dies.
 class TempDir {
  public:

@@ -371,10 +371,10 @@ TEST(PosedReplay, RecordedConfigReplaysAsTheRobotRanWithTheRecordedCalibration) 
 TEST(PosedReplay, RecordedConfigOfARecordingWithoutOneIsRefusedNamingTheFile) {
   TempDir dir;
   const std::string simulated = dir.file("sim.mcap");
-  PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "room",
-                    "--duration", "0.5", "--seed", "1", "--no-cameras", "--config",
-                    source_dir() + "/config/posed.yaml", "-o", simulated},
-                   {}, dir);
+  PosedProcess sim(
+      {simulator(), "sim", "--scenario", "room", "--duration", "0.5", "--seed", "1", "--no-cameras",
+       "--config", source_dir() + "/config/posed.yaml", "-o", simulated},
+      {}, dir);
   ASSERT_EQ(sim.wait_for_exit(60s), 0) << sim.err();
   PosedProcess replay(
       {build_dir() + "/daemon/posed", "--replay", simulated, "--recorded-config", "--max-speed"},

@@ -53,10 +53,10 @@ const std::string& recording() {
   static TempDir dir;
   static const std::string path = [] {
     const std::string p = dir.file("street.mcap");
-    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night",
-                      "--duration", "4", "--seed", "9", "--no-cameras", "--config",
-                      source_dir() + "/config/posed.yaml", "-o", p},
-                     {}, dir);
+    PosedProcess sim(
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "4", "--seed", "9",
+         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", p},
+        {}, dir);
     EXPECT_EQ(sim.wait_for_exit(60s), 0) << sim.err();
     return p;
   }();
@@ -302,10 +302,9 @@ TEST(Ros2Tools, TheFrontEndsImageArrivesAsAJpegOfTheTrackedImage) {
   const std::string drive = dir.file("cameras.mcap");
   {
     TempDir sim_dir;
-    PosedProcess sim(
-        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night", "--duration",
-         "3", "--seed", "9", "--config", source_dir() + "/config/posed.yaml", "-o", drive},
-        {}, sim_dir);
+    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "3", "--seed",
+                      "9", "--config", source_dir() + "/config/posed.yaml", "-o", drive},
+                     {}, sim_dir);
     ASSERT_EQ(sim.wait_for_exit(60s), 0) << sim.err();
   }
   const std::string config = dir.write("posed.yaml", dds_yaml());

@@ -48,10 +48,9 @@ TEST(UnitConfinement, AReplayWithEverySensorRunsWithSchedFifoAndTheSamePoses) {
   open_to_everyone(dir);
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night", "--duration",
-         "4", "--seed", "8", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
+    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "4", "--seed",
+                      "8", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+                     {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
   }
   ::chmod(recording.c_str(), 0644);

@@ -215,7 +215,7 @@ TEST(BagReplay, ASimulatedDriveImportedFromARos1BagIsTrackedInTheBagsTimeBase) {
   const std::string recording = dir.file("street.mcap");
   {
     PosedProcess sim(
-        {posectl, "sim", "--scenario", "street_night", "--duration", "15", "--seed", "8",
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "15", "--seed", "8",
          "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
         {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();

@@ -70,10 +70,9 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
   TempDir dir;
   const std::string recording = dir.file("tunnel.mcap");
   {
-    PosedProcess sim(
-        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "tunnel", "--duration", "30",
-         "--seed", "4", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
+    PosedProcess sim({simulator(), "sim", "--scenario", "tunnel", "--duration", "30", "--seed", "4",
+                      "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+                     {}, dir);
     ASSERT_EQ(sim.wait_for_exit(300s), 0) << sim.err();
   }
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);

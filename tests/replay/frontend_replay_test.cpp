@@ -25,7 +25,7 @@ TEST(FrontendReplay, ANightDriveRunsTheThreeModesOnTheSameFramesAndPosedReportsT
   const std::string recording = dir.file("night.mcap");
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   {
-    PosedProcess sim({posectl, "sim", "--scenario", "street_night", "--duration", "8", "--seed",
+    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "8", "--seed",
                       "4", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
                      {}, dir);
     ASSERT_EQ(sim.wait_for_exit(180s), 0) << sim.err();

@@ -36,10 +36,10 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night",
-                      "--duration", "15", "--seed", "8", "--no-cameras", "--config",
-                      source_dir() + "/config/posed.yaml", "-o", recording},
-                     {}, dir);
+    PosedProcess sim(
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "15", "--seed", "8",
+         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+        {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
   }
   const std::string config =
@@ -124,10 +124,10 @@ TEST(LioReplay, EveryLoopPassStartsAfreshAndRepeatsTheFirst) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night",
-                      "--duration", "6", "--seed", "8", "--no-cameras", "--config",
-                      source_dir() + "/config/posed.yaml", "-o", recording},
-                     {}, dir);
+    PosedProcess sim(
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "6", "--seed", "8",
+         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+        {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
   }
   const std::string config =
@@ -173,11 +173,10 @@ TEST(LioReplay, ALidarOutageIsReportedInTheDataTimeAndTheOdometryCarriesOnThroug
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night", "--duration",
-         "8", "--seed", "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
-         recording, "--fault", "lidar_outage@4+2"},
-        {}, dir);
+    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "8", "--seed",
+                      "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
+                      recording, "--fault", "lidar_outage@4+2"},
+                     {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
     EXPECT_NE(sim.out().find("fault lidar_outage@4+2"), std::string::npos) << sim.out();
   }
@@ -223,11 +222,10 @@ TEST(LioReplay, ABurstOfCorruptLidarPacketsDoesNotStopTheLidar) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night", "--duration",
-         "8", "--seed", "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
-         recording, "--fault", "corrupt_burst@4+1"},
-        {}, dir);
+    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "8", "--seed",
+                      "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
+                      recording, "--fault", "corrupt_burst@4+1"},
+                     {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
   }
   const std::string config =
@@ -260,10 +258,11 @@ TEST(LioReplay, PosectlExportPcdWritesTheMapAndItsKeyframesDeterministically) {
   const std::string recording = dir.file("street.mcap");
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   {
-    PosedProcess sim({posectl, "sim", "--scenario", "street_night", "--duration", "12", "--seed",
-                      "9", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
-                      recording, "--gt", dir.file("truth.txt")},
-                     {}, dir);
+    PosedProcess sim(
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "12", "--seed", "9",
+         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording, "--gt",
+         dir.file("truth.txt")},
+        {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
   }
   for (const char* name : {"a.pcd", "b.pcd"}) {

@@ -65,10 +65,10 @@ TEST(OdometryStallReplay, OdomKeepsFlowingWhileTheLidarStageIsStalledAndTheWatch
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "street_night",
-                      "--duration", "9", "--seed", "3", "--no-cameras", "--config",
-                      source_dir() + "/config/posed.yaml", "-o", recording},
-                     {}, dir);
+    PosedProcess sim(
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "9", "--seed", "3",
+         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+        {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
   }
   config::LoadResult loaded = config::load_config_file(source_dir() + "/config/posed.yaml");

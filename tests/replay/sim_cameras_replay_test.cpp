@@ -34,9 +34,9 @@ TEST(SimCamerasReplay, DepthIsSkippedOnceAndRawThermalDecodes) {
   const std::string recording = dir.file("cameras.mcap");
   int visible_frames = 0, thermal_frames = 0;
   {
-    PosedProcess sim({build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "room",
-                      "--duration", "3", "--seed", "3", "--depth", "--thermal-format", "y16",
-                      "--config", source_dir() + "/config/posed.yaml", "-o", recording},
+    PosedProcess sim({simulator(), "sim", "--scenario", "room", "--duration", "3", "--seed", "3",
+                      "--depth", "--thermal-format", "y16", "--config",
+                      source_dir() + "/config/posed.yaml", "-o", recording},
                      {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
     const std::string out = sim.out();
@@ -96,10 +96,9 @@ TEST(SimCamerasReplay, TheSameSeedWritesTheSameFileByteForByte) {
   std::string files[2];
   for (int i = 0; i < 2; ++i) {
     const std::string path = dir.file("run" + std::to_string(i) + ".mcap");
-    PosedProcess sim(
-        {build_dir() + "/tools/posectl/posectl", "sim", "--scenario", "room", "--duration", "2",
-         "--seed", "11", "--depth", "--config", source_dir() + "/config/posed.yaml", "-o", path},
-        {}, dir);
+    PosedProcess sim({simulator(), "sim", "--scenario", "room", "--duration", "2", "--seed", "11",
+                      "--depth", "--config", source_dir() + "/config/posed.yaml", "-o", path},
+                     {}, dir);
     ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
     files[i] = slurp_file(path);
   }
