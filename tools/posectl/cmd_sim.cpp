@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "drivers/recording/recorder.hpp"
 #include "tools/posectl/commands.hpp"
 #include "tools/sim/fault_sink.hpp"
+#include "tools/sim/miscalibration.hpp"
 #include "tools/sim/rig_config.hpp"
 #include "tools/sim/scenarios.hpp"
 #include "tools/sim/simulator.hpp"
@@ -130,6 +132,11 @@ int run_sim(int argc, char** argv) {
                  "default: the config's thermal_camera.format")
       ->check(CLI::IsMember({"y8", "y16"}));
   app.add_flag("--no-noise", no_noise, "ideal sensors: no noise, jitter or dropouts");
+  bool miscalibrate = false;
+  app.add_flag("--miscalibrate", miscalibrate,
+               "simulate a rig off from what --config says, drawn from the seed: extrinsics by "
+               "1 deg and 2 cm, camera latencies by 2-5 ms, IMU scale and axes by up to 0.5 % "
+               "(tools/sim/miscalibration.hpp); listed in the recording's metadata");
   std::vector<std::string> fault_texts;
   app.add_option("--fault", fault_texts,
                  "a sensor fault KIND@START+DURATION (seconds of true time), repeatable: " +
@@ -157,6 +164,11 @@ int run_sim(int argc, char** argv) {
     return 2;
   }
   sim::SimRig rig = sim::rig_from_config(loaded.config);
+  std::optional<sim::Miscalibration> miscalibration;
+  if (miscalibrate) {
+    miscalibration = sim::draw_miscalibration(seed);
+    sim::apply_miscalibration(*miscalibration, rig);
+  }
   if (thermal_format.empty()) thermal_format = loaded.config.thermal_camera.format;
   if (const auto f = sim::thermal_format_from_string(thermal_format)) {
     rig.thermal_format = *f;
@@ -223,6 +235,11 @@ int run_sim(int argc, char** argv) {
     std::string list;
     for (const sim::Fault& f : faults) list += (list.empty() ? "" : ",") + sim::to_string(f);
     ropt.metadata[std::string(sim::kSimMetadataName)]["faults"] = list;
+  }
+  if (miscalibration) {
+    // How the simulated rig differs from the configured one (true = configured · error).
+    ropt.metadata[std::string(sim::kSimMetadataName)]["miscalibration"] =
+        miscalibration->describe();
   }
   drivers::recording::Recorder recorder;
   if (!recorder.open(out_path, ropt, error)) {
@@ -295,6 +312,9 @@ int run_sim(int argc, char** argv) {
       static_cast<unsigned long long>(counters.messages_written),
       static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",
       gt_path.c_str());
+  if (miscalibration) {
+    std::printf("  miscalibrated rig  %s\n", miscalibration->describe().c_str());
+  }
   for (const sim::Fault& f : faults) std::printf("  fault %s\n", sim::to_string(f).c_str());
   for (std::size_t i = 0; i < faulted.counts().size() && !faults.empty(); ++i) {
     const sim::FaultCounts& c = faulted.counts()[i];

@@ -20,7 +20,8 @@ std::size_t ImuModel::emit(std::span<std::uint8_t> out) {
   const DeviceTime d = schedule_.device(index_);
   const Duration t = schedule_.true_time(index_);
   const TrajectorySample s = trajectory_.at(t);
-  Eigen::Vector3d w = s.w_base_radps, f = s.f_base_mps2;
+  Eigen::Vector3d w = config_.gyro_scale_misalignment * s.w_base_radps;
+  Eigen::Vector3d f = config_.accel_scale_misalignment * s.f_base_mps2;
   if (config_.noise) {
     // Discrete equivalents of the continuous densities at the sample period dt:
     // white σ = density/√dt, bias step σ = walk·√dt.

@@ -38,6 +38,10 @@ struct ImuModelConfig {
   drivers::a9::A9Mounting mounting;
   /// Earth's field in map, device units (the A9 passes the magnetometer through unscaled)
   Eigen::Vector3d mag_map{0.33, 0.0, -0.70};
+  /// measured = M · true before bias and noise: scale factors on the diagonal, axis
+  /// misalignment off it (identity: a perfectly calibrated IMU; --miscalibrate sets them)
+  Eigen::Matrix3d gyro_scale_misalignment = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d accel_scale_misalignment = Eigen::Matrix3d::Identity();
 };
 
 /// The last emitted sample, for tests.
