@@ -78,6 +78,8 @@ function(posed_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 120)
   endif()
+  # Sanitized builds run the same tests 3-15x slower (tools/sanitize-pipeline sets 10).
+  math(EXPR ARG_TIMEOUT "${ARG_TIMEOUT} * ${POSED_TEST_TIMEOUT_SCALE}")
   add_executable(${name} ${ARG_SOURCES})
   # Test binaries compile as unity batches: each test file re-parses GoogleTest, Eigen and the
   # layer headers, which costs more than the test itself on a 2-core machine.

@@ -93,22 +93,27 @@ void FusionStage::emit_states() {
   publisher_.signal();
 }
 
-void FusionStage::watch_silence(std::size_t stream, HostTime stamp) {
+template <class Item>
+void FusionStage::took(std::size_t stream, const Item& item) {
   static constexpr const char* kNames[] = {"imu", "lidar", "visible", "thermal"};
+  const HostTime stamp = stamp_of(item);
+  newest_received_ = std::max(newest_received_, item.received);
   newest_stamp_ = std::max(newest_stamp_, stamp);
-  if (!in_stamp_order_) return;  // live: the host clock judges silence (fill_stream_status())
-  if (counters_.stream_silent[stream].load(std::memory_order_relaxed)) {
-    counters_.stream_silent[stream].store(false, std::memory_order_relaxed);
+  if (heard_[stream] && silent_[stream]) {
+    silent_[stream] = false;
     POSED_LOG_NOTICE("stream %s: no_data -> ok at %.3f s (silent for %.2f s of data)",
                      kNames[stream], stamp.seconds(), (stamp - stream_stamp_[stream]).seconds());
   }
+  stream_stamp_[stream] = heard_[stream] ? std::max(stream_stamp_[stream], stamp) : stamp;
   heard_[stream] = true;
-  stream_stamp_[stream] = std::max(stream_stamp_[stream], stamp);
+  counters_.newest_stamp_by_stream_ns[stream].store(stream_stamp_[stream].ns,
+                                                    std::memory_order_relaxed);
+  if (!in_stamp_order_) return;  // live: the host clock judges silence (fill_stream_status())
   for (std::size_t s = 0; s < 4; ++s) {
-    if (!heard_[s] || counters_.stream_silent[s].load(std::memory_order_relaxed)) continue;
-    if (newest_stamp_ - stream_stamp_[s] <= kStreamStaleAfter) continue;
-    counters_.stream_silent[s].store(true, std::memory_order_relaxed);
-    counters_.silences[s].fetch_add(1, std::memory_order_relaxed);
+    if (!heard_[s] || silent_[s] || newest_stamp_ - stream_stamp_[s] <= kStreamStaleAfter) {
+      continue;
+    }
+    silent_[s] = true;
     POSED_LOG_WARN("stream %s: ok -> no_data at %.3f s (no sample since %.3f s)", kNames[s],
                    (stream_stamp_[s] + kStreamStaleAfter).seconds(), stream_stamp_[s].seconds());
   }
@@ -158,14 +163,10 @@ void FusionStage::run() {
     bool handed = false;
     for (Next n = next(); n != Next::kNone; n = next()) {
       heartbeat_.beat();  // a backlog can take a while; the watchdog must see the stage alive
-      HostTime taken;     // the stamp of what the core takes now
       switch (n) {
         case Next::kImu: {
           ImuItem item = imu.take();
-          newest_received_ = std::max(newest_received_, item.received);
-          taken = stamp_of(item);
-          counters_.newest_stamp_by_stream_ns[0].store(taken.ns, std::memory_order_relaxed);
-          watch_silence(0, taken);
+          took(0, item);
           if (odometry_.in_order != nullptr) {
             // From the anchors released before this sample, as the IMU stage would live.
             route_states();
@@ -180,10 +181,7 @@ void FusionStage::run() {
         }
         case Next::kScan: {
           ScanItem item = scans.take();
-          newest_received_ = std::max(newest_received_, item.received);
-          taken = stamp_of(item);
-          counters_.newest_stamp_by_stream_ns[1].store(taken.ns, std::memory_order_relaxed);
-          watch_silence(1, taken);
+          took(1, item);
           core_->add_scan(std::move(item.scan), produced_);
           counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);
           if (scan_observer_ != nullptr) scan_observer_->after_scan(*core_);
@@ -191,20 +189,14 @@ void FusionStage::run() {
         }
         case Next::kVisible: {
           ImageItem item = visible.take();
-          newest_received_ = std::max(newest_received_, item.received);
-          taken = stamp_of(item);
-          counters_.newest_stamp_by_stream_ns[2].store(taken.ns, std::memory_order_relaxed);
-          watch_silence(2, taken);
+          took(2, item);
           core_->add_image(CameraStream::kVisible, std::move(item.image), produced_);
           counters_.frames_fused[0].fetch_add(1, std::memory_order_relaxed);
           break;
         }
         case Next::kThermal: {
           ImageItem item = thermal.take();
-          newest_received_ = std::max(newest_received_, item.received);
-          taken = stamp_of(item);
-          counters_.newest_stamp_by_stream_ns[3].store(taken.ns, std::memory_order_relaxed);
-          watch_silence(3, taken);
+          took(3, item);
           core_->add_image(CameraStream::kThermal, std::move(item.image), produced_);
           counters_.frames_fused[1].fetch_add(1, std::memory_order_relaxed);
           break;

@@ -43,11 +43,6 @@ struct FusionCounters {
   /// A replay's stream health: merged in stamp order, a stream that fell silent shows as the
   /// merge passing it by.
   std::atomic<std::int64_t> newest_stamp_by_stream_ns[4] = {0, 0, 0, 0};
-  /// a replay's stream (imu, lidar, visible, thermal) is silent now: the merge has passed its
-  /// newest stamp by more than kStreamStaleAfter (in stamp order only: live, the host clock
-  /// judges); and how often it fell silent
-  std::atomic<bool> stream_silent[4] = {false, false, false, false};
-  std::atomic<std::uint64_t> silences[4] = {0, 0, 0, 0};
 
   void publish_figures(const FusionFigures& f) {
     std::lock_guard lock(mutex_);
@@ -118,14 +113,18 @@ class FusionStage {
   HostTime newest_received_;
   /// the newest stamp the core took (FusionCounters::newest_stamp_ns)
   HostTime newest_stamp_;
-  /// In stamp order, after the core took a sample of `stream` (0..3) at `stamp`: that stream is
-  /// heard again if it was silent, and every stream the merge has passed by by more than
-  /// kStreamStaleAfter falls silent; both logged with the data's time.
-  void watch_silence(std::size_t stream, HostTime stamp);
+  /// The core took `item` of `stream` (0..3: imu, lidar, visible, thermal): the newest stamps
+  /// and receive time move on and, in stamp order, that stream is heard again if it was silent,
+  /// and every stream the merge has passed by more than kStreamStaleAfter falls silent; both
+  /// logged with the data's time.
+  template <class Item>
+  void took(std::size_t stream, const Item& item);
   /// per stream: it has delivered at least one sample
   bool heard_[4] = {false, false, false, false};
-  /// per stream: its newest stamp
+  /// per stream: its newest stamp (published as FusionCounters::newest_stamp_by_stream_ns)
   HostTime stream_stamp_[4];
+  /// per stream, in stamp order: the merge has passed its newest stamp by kStreamStaleAfter
+  bool silent_[4] = {false, false, false, false};
 };
 
 }  // namespace posed::pipeline
