@@ -218,6 +218,13 @@ void PoseSinks::status(const pipeline::PipelineStatus& st) {
                   s.health.c_str(), s.clock_state.c_str());
     line += part;
   }
+  if (!st.imu_in_use.empty()) {
+    // Which IMU the estimate runs on, when the D435i's is there as the A9's backup.
+    char part[96];
+    std::snprintf(part, sizeof part, "; imu on %s (%llu failovers)", st.imu_in_use.c_str(),
+                  static_cast<unsigned long long>(st.imu_failovers));
+    line += part;
+  }
   char odom_part[96];
   if (live_clock_ && odom_latency_.receive_to_write.count() > 0) {
     std::snprintf(odom_part, sizeof odom_part, "; %llu odom published, p99 %.2f ms late",

@@ -55,6 +55,14 @@ bool print_run_summary(const RunSummary& r) {
         static_cast<unsigned long long>(s.dropped), s.clock_state.c_str(),
         static_cast<double>(s.clock_offset_ns) * 1e-6, s.clock_drift_ppm);
   }
+  if (!st.imu_in_use.empty()) {
+    std::printf(
+        "  imu failover        %llu time(s) to the D435i's IMU, %llu of its samples used; "
+        "on the %s at the end\n",
+        static_cast<unsigned long long>(st.imu_failovers),
+        static_cast<unsigned long long>(st.imu_backup_used),
+        st.imu_in_use == "a9" ? "A9" : "D435i's IMU");
+  }
   if (!r.options.replay.path.empty()) {
     std::printf("  replayed            %s (%s)\n", r.options.replay.path.c_str(),
                 r.replay_streams.c_str());

@@ -236,6 +236,19 @@ const Field kSchema[] = {
     // the defaults are a D435's factory calibration at 640x480 (librealsense's sample recording
     // in shared/realdata/realsense_d435: fx = fy = 390.43, cx 331.39, cy 242.19, baseline
     // 50.17 mm, depth units 1 mm) and Intel's D435 figures for the working range.
+    F("realsense_imu.enabled", realsense_imu.enabled, "false", "", 0, 0, "",
+      "read the D435i's IMU live (IIO HID accel_3d and gyro_3d): the A9's backup"),
+    F("realsense_imu.failover", realsense_imu.failover, "true", "", 0, 0, "",
+      "while the A9 is silent, the estimate and rt/posed/odom run on the D435i's IMU (live, or "
+      "from a recording that has it); back on the A9 when it returns"),
+    F("realsense_imu.failover_after_s", realsense_imu.failover_after_s, "0.05", "s", 0.01, 5, "",
+      "A9 silence (in sample time) before the D435i's samples take its place"),
+    F("realsense_imu.accel_rate_hz", realsense_imu.accel_rate_hz, "250", "Hz", 50, 1000, "",
+      "accel_3d sampling frequency (63 or 250 Hz; 100 or 200 on newer firmware)"),
+    F("realsense_imu.gyro_rate_hz", realsense_imu.gyro_rate_hz, "200", "Hz", 50, 1000, "",
+      "gyro_3d sampling frequency (200 or 400 Hz)"),
+    F("realsense_imu.clock_latency_s", realsense_imu.clock_latency_s, "0", "s", 0, 1, "",
+      "minimum transport latency, device stamp to arrival"),
     F("depth_camera.enabled", depth_camera.enabled, "false", "", 0, 0, "",
       "simulate and record the D435i depth stream (posed has no depth stage: a replay skips it)"),
     F("depth_camera.width", depth_camera.width, "640", "px", 1, 1280, "",
@@ -275,6 +288,11 @@ const Field kSchema[] = {
       "[1, 0, 0, 0.0143, 0, 1, 0, 0.0006, 0, 0, 1, 0.0006, 0, 0, 0, 1]", "m", 0, 0, "",
       "depth (left IR) imager pose in the visible camera frame: 14.3 mm to the colour camera's "
       "right, as the D435's factory calibration records it"),
+
+    F("extrinsics.T_depth_rsimu", extrinsics.T_depth_rsimu,
+      "[1, 0, 0, 0.0055, 0, 1, 0, 0.0051, 0, 0, 1, 0.0117, 0, 0, 0, 1]", "m", 0, 0, "",
+      "the D435i's IMU in its depth frame (axes as the decoder turns them: the depth frame's; "
+      "offset as rs-enumerate-devices -c reports gyro to depth on a D435i)"),
 
     F("estimator.init_static_s", estimator.init_static_s, "1", "s", 0.05, 30, "",
       "IMU averaged at start for the gravity alignment"),

@@ -143,6 +143,17 @@ struct DepthCameraSection {
   double max_range_m = 0;                 ///< farther: reported 0 [m]
 };
 
+/// The D435i's own IMU (BMI055 over IIO HID): the A9's backup. When the A9 falls silent the
+/// estimate and rt/posed/odom carry on with it, and go back to the A9 when it returns.
+struct RealsenseImuSection {
+  bool enabled = false;            ///< read it live (RealsenseImuSource)
+  bool failover = true;            ///< use it while the A9 is silent (live, or a recording's)
+  double failover_after_s = 0.05;  ///< A9 silence before its samples are replaced [s]
+  double accel_rate_hz = 250;      ///< [Hz]
+  double gyro_rate_hz = 200;       ///< [Hz]
+  double clock_latency_s = 0;      ///< minimum transport latency, device stamp to arrival [s]
+};
+
 struct SyncSection {
   double pairing_tolerance_s = 0.02;  ///< visible/thermal frames further apart are not paired [s]
 };
@@ -152,6 +163,7 @@ struct ExtrinsicsSection {
   Transform4 T_imu_cam{};
   Transform4 T_cam_thermal{};
   Transform4 T_cam_depth{};
+  Transform4 T_depth_rsimu{};
 };
 
 struct FrontendSection {
@@ -265,6 +277,7 @@ struct PosedConfig {
   CameraSection visible_camera;
   CameraSection thermal_camera;
   DepthCameraSection depth_camera;
+  RealsenseImuSection realsense_imu;
   SyncSection sync;
   ExtrinsicsSection extrinsics;
   EstimatorSection estimator;

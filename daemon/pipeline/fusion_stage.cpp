@@ -63,7 +63,8 @@ FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<Fusi
       heartbeat_(heartbeat),
       counters_(counters),
       odometry_(odometry),
-      scan_observer_(scan_observer) {
+      scan_observer_(scan_observer),
+      failover_(Duration::from_seconds(config.realsense_imu.failover_after_s)) {
   // A scan can release a burst of states (the IMU samples it waited for); no allocation later.
   produced_.reserve(4096);
   outgoing_.reserve(4096);
@@ -95,7 +96,7 @@ void FusionStage::emit_states() {
 
 template <class Item>
 void FusionStage::took(std::size_t stream, const Item& item) {
-  static constexpr const char* kNames[] = {"imu", "lidar", "visible", "thermal"};
+  static constexpr const char* kNames[] = {"imu", "lidar", "visible", "thermal", "realsense_imu"};
   const HostTime stamp = stamp_of(item);
   newest_received_ = std::max(newest_received_, item.received);
   newest_stamp_ = std::max(newest_stamp_, stamp);
@@ -109,7 +110,7 @@ void FusionStage::took(std::size_t stream, const Item& item) {
   counters_.newest_stamp_by_stream_ns[stream].store(stream_stamp_[stream].ns,
                                                     std::memory_order_relaxed);
   if (!in_stamp_order_) return;  // live: the host clock judges silence (fill_stream_status())
-  for (std::size_t s = 0; s < 4; ++s) {
+  for (std::size_t s = 0; s < kStreams; ++s) {
     if (!heard_[s] || silent_[s] || newest_stamp_ - stream_stamp_[s] <= kStreamStaleAfter) {
       continue;
     }
@@ -119,24 +120,54 @@ void FusionStage::took(std::size_t stream, const Item& item) {
   }
 }
 
+void FusionStage::hand_imu(const ImuItem& item) {
+  if (odometry_.in_order != nullptr) {
+    // From the anchors released before this sample, as the IMU stage would live.
+    route_states();
+    NavState odom;
+    if (odometry_.in_order->add_imu(item.sample, odom)) {
+      odom.received = item.received;
+      outgoing_.push_back(odom);
+    }
+  }
+  core_->add_imu(item.sample, produced_);
+}
+
+void FusionStage::note_imu_switch() {
+  counters_.imu_on_backup.store(failover_.in_use() == ImuInUse::kBackup, std::memory_order_relaxed);
+  counters_.imu_failovers.store(failover_.failovers(), std::memory_order_relaxed);
+  if (failover_.in_use() == ImuInUse::kBackup) {
+    POSED_LOG_WARN(
+        "imu: the A9 is silent (newest sample %.3f s): the estimate runs on the D435i's "
+        "IMU from %.3f s",
+        failover_.newest_primary().seconds(), failover_.switched_at().seconds());
+  } else {
+    POSED_LOG_NOTICE("imu: back on the A9 at %.3f s (%llu D435i samples used so far)",
+                     failover_.switched_at().seconds(),
+                     static_cast<unsigned long long>(failover_.backup_used()));
+  }
+}
+
 void FusionStage::run() {
   apply_thread_policy("posed-fusion", config_.threads.fusion);
   Lane<ImuItem> imu(inputs_.imu);
   Lane<ScanItem> scans(inputs_.scans);
   Lane<ImageItem> visible(inputs_.visible);
   Lane<ImageItem> thermal(inputs_.thermal);
+  Lane<ImuItem> backup_imu(inputs_.backup_imu);
 
   // Which lane goes next: the oldest head; on equal stamps the IMU first (a scan or frame ending
   // exactly at an IMU sample finds it already in the core), then scans, visible, thermal. Stamp
   // order waits for every open lane.
-  enum class Next { kNone, kImu, kScan, kVisible, kThermal };
+  enum class Next { kNone, kImu, kScan, kVisible, kThermal, kBackupImu };
   const auto next = [&] {
     imu.refill();
     scans.refill();
     visible.refill();
     thermal.refill();
-    if (in_stamp_order_ &&
-        (imu.waiting() || scans.waiting() || visible.waiting() || thermal.waiting())) {
+    backup_imu.refill();
+    if (in_stamp_order_ && (imu.waiting() || scans.waiting() || visible.waiting() ||
+                            thermal.waiting() || backup_imu.waiting())) {
       return Next::kNone;
     }
     Next best = Next::kNone;
@@ -151,10 +182,11 @@ void FusionStage::run() {
     consider(scans, Next::kScan);
     consider(visible, Next::kVisible);
     consider(thermal, Next::kThermal);
+    consider(backup_imu, Next::kBackupImu);
     return best;
   };
   const auto all_ended = [&] {
-    return imu.ended() && scans.ended() && visible.ended() && thermal.ended();
+    return imu.ended() && scans.ended() && visible.ended() && thermal.ended() && backup_imu.ended();
   };
 
   std::uint64_t handed_since_figures = 0;
@@ -167,16 +199,21 @@ void FusionStage::run() {
         case Next::kImu: {
           ImuItem item = imu.take();
           took(0, item);
-          if (odometry_.in_order != nullptr) {
-            // From the anchors released before this sample, as the IMU stage would live.
-            route_states();
-            NavState odom;
-            if (odometry_.in_order->add_imu(item.sample, odom)) {
-              odom.received = item.received;
-              outgoing_.push_back(odom);
-            }
+          // Without a backup IMU every sample is the A9's and in order: nothing to decide.
+          const bool use =
+              inputs_.backup_imu == nullptr || failover_.take_primary(item.sample.stamp);
+          if (failover_.switched()) note_imu_switch();
+          if (use) hand_imu(item);
+          break;
+        }
+        case Next::kBackupImu: {
+          ImuItem item = backup_imu.take();
+          took(4, item);
+          if (failover_.take_backup(item.sample.stamp)) {
+            if (failover_.switched()) note_imu_switch();
+            counters_.imu_backup_used.store(failover_.backup_used(), std::memory_order_relaxed);
+            hand_imu(item);
           }
-          core_->add_imu(item.sample, produced_);
           break;
         }
         case Next::kScan: {

@@ -22,6 +22,7 @@
 #include "core/estimator/fusion_core.hpp"
 #include "core/spsc_queue.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/imu_failover.hpp"
 #include "daemon/pipeline/odometry_path.hpp"
 #include "daemon/pipeline/scan_observer.hpp"
 #include "daemon/pipeline/stage_support.hpp"
@@ -39,10 +40,14 @@ struct FusionCounters {
   /// stamp of the newest measurement the core took: where the merge is (a replay's data clock)
   /// [ns]
   std::atomic<std::int64_t> newest_stamp_ns{0};
-  /// the newest stamp the core took per stream: imu, lidar (a scan's end), visible, thermal [ns].
-  /// A replay's stream health: merged in stamp order, a stream that fell silent shows as the
-  /// merge passing it by.
-  std::atomic<std::int64_t> newest_stamp_by_stream_ns[4] = {0, 0, 0, 0};
+  /// the newest stamp the core took per stream: imu, lidar (a scan's end), visible, thermal,
+  /// realsense_imu [ns]. A replay's stream health: merged in stamp order, a stream that fell
+  /// silent shows as the merge passing it by.
+  std::atomic<std::int64_t> newest_stamp_by_stream_ns[5] = {0, 0, 0, 0, 0};
+  /// the D435i IMU standing in for the A9 (imu_failover.hpp): now, how often, how many samples
+  std::atomic<bool> imu_on_backup{false};
+  std::atomic<std::uint64_t> imu_failovers{0};
+  std::atomic<std::uint64_t> imu_backup_used{0};
 
   void publish_figures(const FusionFigures& f) {
     std::lock_guard lock(mutex_);
@@ -73,6 +78,8 @@ struct FusionInputs {
   SpscQueue<ScanItem>* scans = nullptr;     ///< null without a lidar
   SpscQueue<ImageItem>* visible = nullptr;  ///< null without the visible camera
   SpscQueue<ImageItem>* thermal = nullptr;  ///< null without the thermal camera
+  /// the D435i's IMU, used while the A9 is silent; null without it or realsense_imu.failover
+  SpscQueue<ImuItem>* backup_imu = nullptr;
 };
 
 class FusionStage {
@@ -91,6 +98,10 @@ class FusionStage {
   class Lane;
   /// Hands the core every measurement the merge rule releases now; true if it handed any.
   bool dispatch_ready();
+  /// Hands one IMU sample (the A9's or, standing in, the D435i's) to the odometry and the core.
+  void hand_imu(const ImuItem& item);
+  /// Logs and counts a hand-over between the A9 and the D435i's IMU.
+  void note_imu_switch();
   /// Routes the states the core produced: to the publisher and, as anchors, to the odometry.
   void route_states();
   void emit_states();
@@ -113,18 +124,21 @@ class FusionStage {
   HostTime newest_received_;
   /// the newest stamp the core took (FusionCounters::newest_stamp_ns)
   HostTime newest_stamp_;
-  /// The core took `item` of `stream` (0..3: imu, lidar, visible, thermal): the newest stamps
-  /// and receive time move on and, in stamp order, that stream is heard again if it was silent,
-  /// and every stream the merge has passed by more than kStreamStaleAfter falls silent; both
-  /// logged with the data's time.
+  /// The core took `item` of `stream` (0..4: imu, lidar, visible, thermal, realsense_imu): the
+  /// newest stamps and receive time move on and, in stamp order, that stream is heard again if it
+  /// was silent, and every stream the merge has passed by more than kStreamStaleAfter falls silent;
+  /// both logged with the data's time.
   template <class Item>
   void took(std::size_t stream, const Item& item);
+  static constexpr std::size_t kStreams = 5;
   /// per stream: it has delivered at least one sample
-  bool heard_[4] = {false, false, false, false};
+  bool heard_[kStreams] = {false, false, false, false, false};
   /// per stream: its newest stamp (published as FusionCounters::newest_stamp_by_stream_ns)
-  HostTime stream_stamp_[4];
+  HostTime stream_stamp_[kStreams];
   /// per stream, in stamp order: the merge has passed its newest stamp by kStreamStaleAfter
-  bool silent_[4] = {false, false, false, false};
+  bool silent_[kStreams] = {false, false, false, false, false};
+  /// which IMU feeds the core, decided in data order
+  ImuFailover failover_;
 };
 
 }  // namespace posed::pipeline

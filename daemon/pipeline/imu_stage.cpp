@@ -54,6 +54,8 @@ void ImuStage::push(const ImuSample& sample) {
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
   pushed_ = true;
+  if (newest_stamp_out_ != nullptr)
+    newest_stamp_out_->store(sample.stamp.ns, std::memory_order_release);
   if (odometry_ != nullptr) odometry_->on_imu(sample, chunk_received_);
 }
 

@@ -4,6 +4,8 @@
 // serial frames, sensor_msgs/Imu from an imported ROS 1 bag (imu_stage_ros1.cpp), and Linux CAN
 // frames decoded by imu.can_mapping (imu_stage_can.cpp).
 
+#include <atomic>
+
 #include "core/spsc_queue.hpp"
 #include "core/sync/clock_sync.hpp"
 #include "daemon/config/posed_config.hpp"
@@ -22,6 +24,8 @@ class ImuStage {
            Wakeup& consumer, Heartbeat& heartbeat, StreamCounters& counters);
   /// Optional: odometry from every sample on this thread, right after it went to the queue.
   void set_odometry(OdometryPath* odometry) { odometry_ = odometry; }
+  /// Optional: where each pushed sample's stamp goes (the D435i stage's failover reads it) [ns].
+  void set_newest_stamp_out(std::atomic<std::int64_t>* out) { newest_stamp_out_ = out; }
   /// Runs until the Source ends (end of recording, or stopped), then forwards end-of-stream.
   void run();
 
@@ -53,6 +57,7 @@ class ImuStage {
   std::uint64_t malformed_seen_ = 0;
   bool pushed_ = false;
   OdometryPath* odometry_ = nullptr;
+  std::atomic<std::int64_t>* newest_stamp_out_ = nullptr;
   /// the Source's receive stamp of the chunk being decoded
   HostTime chunk_received_;
 };

@@ -11,6 +11,7 @@
 // latency means nothing anyway.
 
 #include <functional>
+#include <mutex>
 
 #include "core/estimator/nav_state.hpp"
 #include "core/estimator/odometry_propagator.hpp"
@@ -29,12 +30,19 @@ class OdometryPath {
   OdometryPath(const estimator::OdometryPropagatorConfig& config, SpscQueue<AnchorItem>& anchors,
                std::function<void(const NavState&)> on_odom);
 
-  /// One synced IMU sample (already on its way to the back end), received at `received`.
+  /// One synced IMU sample (already on its way to the back end), received at `received`. From
+  /// the A9's stage, and from the D435i IMU's while it stands in for a silent A9
+  /// (imu_failover.hpp): a sample not newer than the last one propagated is skipped (the two
+  /// overlap at a hand-over).
   void on_imu(const ImuSample& sample, HostTime received);
 
   const estimator::OdometryFigures& figures() const { return propagator_.figures(); }
 
  private:
+  /// the two IMU stages' threads meet here only at a failover; uncontended otherwise
+  std::mutex mutex_;
+  bool have_last_ = false;
+  HostTime last_stamp_;
   estimator::OdometryPropagator propagator_;
   SpscQueue<AnchorItem>& anchors_;
   std::function<void(const NavState&)> on_odom_;

@@ -14,6 +14,7 @@
 #include "daemon/pipeline/imu_stage.hpp"
 #include "daemon/pipeline/lidar_stage.hpp"
 #include "daemon/pipeline/publisher_stage.hpp"
+#include "daemon/pipeline/realsense_imu_stage.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
 #include "drivers/velodyne/calibration_loader.hpp"
@@ -91,6 +92,11 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
         static_cast<std::size_t>(config.queues.scan_capacity), queue_policy(sources_.lidar.get()),
         block_timeout(sources_.lidar.get()));
   }
+  if (sources_.realsense_imu && config.realsense_imu.failover) {
+    backup_imu_queue_ = std::make_unique<SpscQueue<ImuItem>>(
+        static_cast<std::size_t>(config.queues.imu_capacity),
+        queue_policy(sources_.realsense_imu.get()), block_timeout(sources_.realsense_imu.get()));
+  }
   for (const CameraStream s : kCameraStreams) {
     const drivers::Source* source = sources_.camera(s).get();
     if (source == nullptr) continue;
@@ -158,6 +164,14 @@ bool Pipeline::start(std::string& error) {
                                             imu_counters_);
     return [this] { imu_stage_->run(); };
   });
+  if (backup_imu_queue_) {
+    add_stage("realsense_imu_source", [&](Heartbeat& beat) {
+      realsense_imu_stage_ =
+          std::make_unique<RealsenseImuStage>(config_, *sources_.realsense_imu, *backup_imu_queue_,
+                                              fusion_ready_, beat, realsense_imu_counters_);
+      return [this] { realsense_imu_stage_->run(); };
+    });
+  }
   if (sources_.lidar) {
     add_stage("lidar_source", [&](Heartbeat& beat) {
       lidar_stage_ = std::make_unique<LidarStage>(config_, std::move(calibration), *sources_.lidar,
@@ -178,8 +192,8 @@ bool Pipeline::start(std::string& error) {
   }
   // Recordings and generators at full speed: merge by stamp so replays are deterministic.
   bool in_stamp_order = !sources_.imu->live();
-  for (const drivers::Source* s :
-       {sources_.lidar.get(), sources_.visible.get(), sources_.thermal.get()}) {
+  for (const drivers::Source* s : {sources_.lidar.get(), sources_.visible.get(),
+                                   sources_.thermal.get(), sources_.realsense_imu.get()}) {
     if (s != nullptr && s->live()) in_stamp_order = false;
   }
   estimator::LioEstimator* lio = nullptr;
@@ -206,16 +220,20 @@ bool Pipeline::start(std::string& error) {
                                                               block_timeout(sources_.imu.get()));
       odometry_ = std::make_unique<OdometryPath>(odometry, *anchor_queue_, outputs_.on_odom);
       imu_stage_->set_odometry(odometry_.get());
+      if (realsense_imu_stage_) {
+        imu_stage_->set_newest_stamp_out(&a9_newest_ns_);
+        realsense_imu_stage_->set_odometry(odometry_.get(), &a9_newest_ns_);
+      }
       handover.anchors = anchor_queue_.get();
     }
   }
   add_stage("fusion", [&](Heartbeat& beat) {
-    fusion_stage_ =
-        std::make_unique<FusionStage>(config_, std::move(core),
-                                      FusionInputs{&imu_queue_, scan_queue_.get(),
-                                                   image_queues_[0].get(), image_queues_[1].get()},
-                                      in_stamp_order, state_queue_, fusion_ready_, state_ready_,
-                                      beat, *fusion_counters_, handover, outputs_.scan_observer);
+    fusion_stage_ = std::make_unique<FusionStage>(
+        config_, std::move(core),
+        FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get(),
+                     backup_imu_queue_.get()},
+        in_stamp_order, state_queue_, fusion_ready_, state_ready_, beat, *fusion_counters_,
+        handover, outputs_.scan_observer);
     return [this] { fusion_stage_->run(); };
   });
   add_stage("publisher", [&](Heartbeat& beat) {
@@ -240,6 +258,13 @@ bool Pipeline::start(std::string& error) {
                      to_string(s).data(), camera_error.c_str());
     }
   }
+  if (backup_imu_queue_) {
+    std::string rsimu_error;
+    if (!sources_.realsense_imu->open(rsimu_error)) {
+      POSED_LOG_WARN("D435i IMU source not open yet: %s; retrying in the background",
+                     rsimu_error.c_str());
+    }
+  }
   std::string open_error;
   if (!sources_.imu->open(open_error)) {
     // The device may appear later (USB enumeration, cable): the Source retries on read().
@@ -261,6 +286,7 @@ void Pipeline::request_stop() {
   if (sources_.lidar) sources_.lidar->request_stop();
   if (sources_.visible) sources_.visible->request_stop();
   if (sources_.thermal) sources_.thermal->request_stop();
+  if (sources_.realsense_imu) sources_.realsense_imu->request_stop();
 }
 
 void Pipeline::join() {
@@ -328,6 +354,16 @@ PipelineStatus Pipeline::status() const {
                        health_[2 + index_of(s)], consumed(2 + index_of(s)));
     st.streams.push_back(std::move(camera));
     st.camera_frames_fused[index_of(s)] = fusion_counters_->frames_fused[index_of(s)].load();
+  }
+  if (backup_imu_queue_) {
+    StreamStatus rsimu;
+    rsimu.name = "realsense_imu";
+    fill_stream_status(rsimu, realsense_imu_counters_, *sources_.realsense_imu, health_now,
+                       health_[4], consumed(4));
+    st.streams.push_back(std::move(rsimu));
+    st.imu_in_use = fusion_counters_->imu_on_backup.load() ? "d435i" : "a9";
+    st.imu_failovers = fusion_counters_->imu_failovers.load();
+    st.imu_backup_used = fusion_counters_->imu_backup_used.load();
   }
   return st;
 }

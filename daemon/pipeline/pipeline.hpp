@@ -39,6 +39,7 @@ class CameraAidedCore;
 namespace posed::pipeline {
 
 class ImuStage;
+class RealsenseImuStage;
 class LidarStage;
 class CameraStage;
 class FusionStage;
@@ -55,6 +56,8 @@ struct PipelineSources {
   std::unique_ptr<drivers::Source> visible;
   /// PLUG 617 thermal frames (channel 0); optional
   std::unique_ptr<drivers::Source> thermal;
+  /// the D435i's IMU: IIO HID accel (channel 0) and gyro (1) records; optional, the A9's backup
+  std::unique_ptr<drivers::Source> realsense_imu;
   /// The Velodyne calibration the lidar stream was recorded with (its file's text, from the
   /// recording; `posed --replay FILE --recorded-config`), used instead of lidar.calibration so a
   /// replay decodes the packets as the robot did; empty: lidar.calibration as configured.
@@ -82,6 +85,7 @@ struct PipelineSources {
     f(lidar);
     f(visible);
     f(thermal);
+    f(realsense_imu);
   }
 };
 
@@ -159,6 +163,10 @@ class Pipeline {
   PipelineSources sources_;
   PipelineOutputs outputs_;
   SpscQueue<ImuItem> imu_queue_;
+  /// the D435i IMU's samples to the fusion stage (with that Source and realsense_imu.failover)
+  std::unique_ptr<SpscQueue<ImuItem>> backup_imu_queue_;
+  /// the A9's newest sample stamp, for the D435i stage's live odometry hand-over [ns]
+  std::atomic<std::int64_t> a9_newest_ns_{0};
   std::unique_ptr<SpscQueue<ScanItem>> scan_queue_;
   /// per CameraStream; null without that camera
   std::unique_ptr<SpscQueue<ImageItem>> image_queues_[2];
@@ -167,10 +175,12 @@ class Pipeline {
   Wakeup fusion_ready_;
   Wakeup state_ready_;
 
-  /// status(): each stream's health between reports (imu, lidar, visible, thermal)
+  /// status(): each stream's health between reports (imu, lidar, visible, thermal,
+  /// realsense_imu)
   mutable std::mutex health_mutex_;
-  mutable StreamHealthMemory health_[4];
+  mutable StreamHealthMemory health_[5];
   StreamCounters imu_counters_;
+  StreamCounters realsense_imu_counters_;
   StreamCounters lidar_counters_;
   StreamCounters camera_counters_[2];
   std::unique_ptr<LidarScanCounters> scan_counters_;
@@ -183,6 +193,7 @@ class Pipeline {
   std::vector<Stage> stages_;
 
   std::unique_ptr<ImuStage> imu_stage_;
+  std::unique_ptr<RealsenseImuStage> realsense_imu_stage_;
   std::unique_ptr<LidarStage> lidar_stage_;
   std::unique_ptr<CameraStage> camera_stages_[2];
   std::unique_ptr<FusionStage> fusion_stage_;

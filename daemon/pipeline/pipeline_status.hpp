@@ -44,8 +44,13 @@ struct PipelineStatus {
   std::uint64_t camera_frames_fused[2] = {0, 0};
   /// the estimator's own figures (scans used, degeneracy, biases, re-initialisations)
   FusionFigures estimator;
-  std::uint64_t states = 0;          ///< states produced by the fusion core
-  std::uint64_t states_dropped = 0;  ///< states dropped between fusion and publisher
+  /// which IMU the estimate runs on: "a9", or "d435i" while it stands in for a silent A9; empty
+  /// without the D435i's IMU (realsense_imu.failover)
+  std::string imu_in_use;
+  std::uint64_t imu_failovers = 0;    ///< times the D435i's IMU took over
+  std::uint64_t imu_backup_used = 0;  ///< its samples the estimate used
+  std::uint64_t states = 0;           ///< states produced by the fusion core
+  std::uint64_t states_dropped = 0;   ///< states dropped between fusion and publisher
 };
 
 }  // namespace posed::pipeline

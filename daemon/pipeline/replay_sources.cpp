@@ -120,14 +120,25 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     }
   }
   // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp).
-  // Other streams (the D435i's depth, a second IMU) have no stage: listed, said once in the log,
+  // Other streams (the D435i's depth) have no stage: listed, said once in the log,
   // never read.
   const auto replay_camera = [&](const std::string& stream) { return streams.count(stream) != 0; };
   if (replay_camera("visible")) out.built.sources.visible = make("visible");
   if (replay_camera("thermal")) out.built.sources.thermal = make("thermal");
+  // The D435i's IMU as raw IIO records (posed --record, posectl sim --realsense-imu): the A9's
+  // backup. An imported sensor_msgs/Imu of it has no stage yet.
+  bool rsimu_raw = false;
+  for (const auto& [id, channel] : reader.channels()) {
+    if (raw::metadata_value(channel.metadata, raw::kStreamKey) == "realsense_imu" &&
+        channel.message_encoding == raw::kMessageEncoding) {
+      rsimu_raw = true;
+    }
+  }
+  if (rsimu_raw) out.built.sources.realsense_imu = make("realsense_imu");
   std::string skipped;
   for (const auto& s : streams) {
-    const bool replayed = s == "imu" || s == "lidar" || s == "visible" || s == "thermal";
+    const bool replayed = s == "imu" || s == "lidar" || s == "visible" || s == "thermal" ||
+                          (s == "realsense_imu" && out.built.sources.realsense_imu);
     out.streams += (out.streams.empty() ? "" : ", ") + s + (replayed ? "" : " (not replayed)");
     if (!replayed) skipped += (skipped.empty() ? "" : ", ") + s;
   }

@@ -9,6 +9,7 @@
 #include "daemon/pipeline/camera_stage.hpp"
 #include "drivers/camera/aravis_source.hpp"
 #include "drivers/camera/d4xx_video_source.hpp"
+#include "drivers/camera/realsense_imu_source.hpp"
 #include "drivers/camera/v4l2_source.hpp"
 #include "drivers/imu/serial_source.hpp"
 #include "drivers/imu/socketcan_source.hpp"
@@ -134,6 +135,13 @@ BuiltSources make_sources(const config::PosedConfig& config, std::string& error)
       built.sources = {};
       return built;
     }
+  }
+  if (config.realsense_imu.enabled) {
+    drivers::camera::RealsenseImuSourceConfig rs;
+    rs.accel.sampling_frequency_hz = config.realsense_imu.accel_rate_hz;
+    rs.gyro.sampling_frequency_hz = config.realsense_imu.gyro_rate_hz;
+    built.sources.realsense_imu =
+        std::make_unique<drivers::camera::RealsenseImuSource>("realsense_imu", std::move(rs));
   }
   if (!config.lidar.enabled) return built;
   if (config.lidar.source == "udp") {

@@ -108,7 +108,7 @@ int run_sim(int argc, char** argv) {
   std::string scenario = "room", out_path, gt_path, config_path = "config/posed.yaml";
   double duration_s = 60.0;
   std::uint64_t seed = 1;
-  bool no_cameras = false, no_lidar = false, no_noise = false, depth = false;
+  bool no_cameras = false, no_lidar = false, no_noise = false, depth = false, rsimu = false;
   std::string thermal_format;
   app.add_option("--scenario", scenario, "world and drive: " + scenarios)->capture_default_str();
   app.add_option("--duration", duration_s, "simulated time [s]")
@@ -127,6 +127,9 @@ int run_sim(int argc, char** argv) {
   app.add_flag("--no-lidar", no_lidar, "no lidar");
   app.add_flag("--depth", depth,
                "also the D435i's Z16 depth stream (as config depth_camera.enabled: true)");
+  app.add_flag("--realsense-imu", rsimu,
+               "also the D435i's own IMU (accel 250 Hz, gyro 200 Hz as IIO HID records), the A9's "
+               "backup (as config realsense_imu.enabled: true)");
   app.add_option("--thermal-format", thermal_format,
                  "thermal output: y8 (8-bit video after AGC, as M2DGR) or y16 (raw counts); "
                  "default: the config's thermal_camera.format")
@@ -186,6 +189,7 @@ int run_sim(int argc, char** argv) {
   options.lidar = !no_lidar;
   options.visible_camera = options.thermal_camera = !no_cameras;
   options.depth_camera = !no_cameras && (depth || loaded.config.depth_camera.enabled);
+  options.realsense_imu = rsimu || loaded.config.realsense_imu.enabled;
   options.noise = !no_noise;
   std::string error;
   // Built here too for what the recording's metadata says of it (run_simulation builds its own).
@@ -312,6 +316,11 @@ int run_sim(int argc, char** argv) {
       static_cast<unsigned long long>(counters.messages_written),
       static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",
       gt_path.c_str());
+  if (options.realsense_imu) {
+    std::printf("  D435i IMU  %llu accel and %llu gyro records\n",
+                static_cast<unsigned long long>(summary.realsense_accel_records),
+                static_cast<unsigned long long>(summary.realsense_gyro_records));
+  }
   if (miscalibration) {
     std::printf("  miscalibrated rig  %s\n", miscalibration->describe().c_str());
   }

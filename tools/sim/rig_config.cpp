@@ -17,6 +17,9 @@ SimRig rig_from_config(const config::PosedConfig& cfg) {
   rig.T_imu_cam = pipeline::to_isometry(cfg.extrinsics.T_imu_cam);
   rig.T_cam_thermal = pipeline::to_isometry(cfg.extrinsics.T_cam_thermal);
   rig.T_cam_depth = pipeline::to_isometry(cfg.extrinsics.T_cam_depth);
+  rig.T_depth_rsimu = pipeline::to_isometry(cfg.extrinsics.T_depth_rsimu);
+  rig.realsense_imu.accel_rate_hz = cfg.realsense_imu.accel_rate_hz;
+  rig.realsense_imu.gyro_rate_hz = cfg.realsense_imu.gyro_rate_hz;
   rig.imu.rate_hz = cfg.imu.rate_hz;
   rig.imu.gyro_noise_density = cfg.imu.gyro_noise_density;
   rig.imu.gyro_random_walk = cfg.imu.gyro_random_walk;

@@ -5,12 +5,12 @@
 #include <queue>
 #include <random>
 
+#include "drivers/camera/d4xx_metadata_writer.hpp"
 #include "drivers/common/wire_format.hpp"
 #include "drivers/recording/raw_channels.hpp"
 #include "drivers/velodyne/packet_format.hpp"
 #include "drivers/velodyne/position_packet.hpp"
 #include "tools/sim/bvh.hpp"
-#include "drivers/camera/d4xx_metadata_writer.hpp"
 #include "tools/sim/lidar_model.hpp"
 #include "tools/sim/scenarios.hpp"
 #include "tools/sim/visible_camera.hpp"
@@ -193,10 +193,27 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
       std::uniform_real_distribution<double>(0, 1.0 / depth_cfg.rate_hz)(seeder));
   DepthCamera depth(depth_cfg, scene, depth_clock, next_seed(), depth_phase);
 
+  // The D435i's IMU: its clock is the camera's, its transport USB HID (a report every sample,
+  // 1-2 ms). It draws after everything else, so turning it on leaves every other stream's bytes
+  // as they were.
+  RealsenseImuModelConfig rsimu_cfg = rig.realsense_imu;
+  rsimu_cfg.T_base_rsimu = rig.T_imu_cam * rig.T_cam_depth * rig.T_depth_rsimu;
+  rsimu_cfg.noise = options.noise;
+  ClockModelConfig rsimu_clock_cfg = clocks.visible;
+  rsimu_clock_cfg.latency_ns = 1'000'000;
+  rsimu_clock_cfg.jitter_mean_ns = options.noise ? 500'000 : 0;
+  std::optional<ClockModel> accel_clock, gyro_clock;
+  std::optional<RealsenseImuModel> rsimu;
+  if (options.realsense_imu) {
+    accel_clock.emplace(rsimu_clock_cfg, epoch, next_seed());
+    gyro_clock.emplace(rsimu_clock_cfg, epoch, next_seed());
+    rsimu.emplace(rsimu_cfg, trajectory, *gyro_clock, next_seed());
+  }
+
   // Streams, named as the daemon's Sources name them (raw_channels.hpp).
   const std::string scen = "sim " + options.scenario + " seed " + std::to_string(options.seed);
   int s_imu = -1, s_lidar = -1, s_pos = -1, s_vis = -1, s_vis_meta = -1, s_th = -1;
-  int s_depth = -1, s_depth_meta = -1;
+  int s_depth = -1, s_depth_meta = -1, s_rs_accel = -1, s_rs_gyro = -1;
   bool refused = false;
   auto add = [&](const char* name, std::string_view wire, std::uint32_t channel,
                  const std::map<std::string, std::string>& md) {
@@ -243,6 +260,15 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
     md["baseline_m"] = num(depth_cfg.baseline_m);
     s_depth = add("depth", "z16", 0, md);
     s_depth_meta = add("depth", drivers::wire::kUvcMetaD4xx, 1, md);
+  }
+  if (options.realsense_imu) {
+    auto md = clock_metadata(rsimu_clock_cfg, true);
+    md["accel_rate_hz"] = num(rsimu_cfg.accel_rate_hz);
+    md["gyro_rate_hz"] = num(rsimu_cfg.gyro_rate_hz);
+    md["device"] = scen;
+    // Channel 0 accel, 1 gyro, as RealsenseImuSource delivers them.
+    s_rs_accel = add("realsense_imu", realsense_accel_wire_format(), 0, md);
+    s_rs_gyro = add("realsense_imu", realsense_gyro_wire_format(), 1, md);
   }
   if (refused) {
     error = "the sink refused a stream";
@@ -326,6 +352,14 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
       drain(
           w1, depth_clock, s_depth, summary.depth_frames, [&] { return depth.next_send(); },
           [&](HostTime arrival) { return d4xx_frame(depth, arrival, s_depth_meta, queue); });
+    }
+    if (rsimu) {
+      drain(
+          w1, *accel_clock, s_rs_accel, summary.realsense_accel_records,
+          [&] { return rsimu->next_accel(); }, [&](HostTime) { return rsimu->emit_accel(); });
+      drain(
+          w1, *gyro_clock, s_rs_gyro, summary.realsense_gyro_records,
+          [&] { return rsimu->next_gyro(); }, [&](HostTime) { return rsimu->emit_gyro(); });
     }
     if (!queue.flush_until(epoch + w1.ns, sink)) {
       error = "the sink failed to write";

@@ -21,6 +21,7 @@
 #include "tools/sim/depth_camera.hpp"
 #include "tools/sim/gbuffer.hpp"
 #include "tools/sim/imu_model.hpp"
+#include "tools/sim/realsense_imu_model.hpp"
 #include "tools/sim/sim_sink.hpp"
 #include "tools/sim/thermal_camera.hpp"
 
@@ -58,6 +59,11 @@ struct SimRig {
   DepthCameraConfig depth;
   /// depth (left IR) imager in the colour camera frame
   Eigen::Isometry3d T_cam_depth = Eigen::Isometry3d::Identity();
+  /// the D435i's own IMU: rates, noise (its T_base_rsimu is ignored: the IMU is
+  /// T_imu_cam · T_cam_depth · T_depth_rsimu)
+  RealsenseImuModelConfig realsense_imu;
+  /// the D435i's IMU in the depth frame (depth axes, offset to where the BMI055 sits)
+  Eigen::Isometry3d T_depth_rsimu = Eigen::Isometry3d::Identity();
 };
 
 struct SimOptions {
@@ -71,6 +77,8 @@ struct SimOptions {
   bool thermal_camera = true;
   /// the D435i's depth stream (M2DGR has none, so off unless asked for)
   bool depth_camera = false;
+  /// the D435i's IMU (accel and gyro over IIO HID; the A9's backup), off unless asked for
+  bool realsense_imu = false;
   /// false: ideal sensors (no noise, no jitter, no dropouts); geometry stays the same
   bool noise = true;
   /// ground-truth pose rate [Hz]
@@ -82,6 +90,8 @@ struct SimOptions {
 struct SimSummary {
   std::uint64_t lidar_packets = 0, position_packets = 0, imu_frames = 0;
   std::uint64_t visible_frames = 0, thermal_frames = 0, depth_frames = 0, ground_truth_poses = 0;
+  /// D435i IMU records, accel and gyro
+  std::uint64_t realsense_accel_records = 0, realsense_gyro_records = 0;
   /// lidar rays cast / returns encoded
   std::uint64_t lidar_rays = 0, lidar_returns = 0;
   /// world size
