@@ -1,8 +1,6 @@
 #include "tools/hil/hil_faults.hpp"
 
-#include <charconv>
-#include <cmath>
-#include <cstdio>
+#include "tools/faults/fault_text.hpp"
 
 namespace posed::hil {
 namespace {
@@ -16,11 +14,6 @@ constexpr std::pair<HilFaultTarget, std::string_view> kTargets[] = {
     {HilFaultTarget::kAll, "all"},
     {HilFaultTarget::kLidar, "lidar"},
     {HilFaultTarget::kImu, "imu"}};
-
-bool parse_seconds(std::string_view text, double& out) {
-  const auto r = std::from_chars(text.data(), text.data() + text.size(), out);
-  return r.ec == std::errc{} && r.ptr == text.data() + text.size() && std::isfinite(out);
-}
 
 }  // namespace
 
@@ -47,20 +40,18 @@ std::string to_string(const HilFault& fault) {
       if (t == fault.target) text += ":" + std::string(name);
     }
   }
-  char window[64];
-  std::snprintf(window, sizeof window, "@%g+%g", fault.start_s, fault.duration_s);
-  return text + window;
+  return text + faults::window_text({fault.start_s, fault.duration_s});
 }
 
 bool parse_hil_fault(std::string_view text, HilFault& out, std::string& error) {
-  const auto at = text.find('@');
-  const auto plus = text.find('+', at == std::string_view::npos ? 0 : at);
-  if (at == std::string_view::npos || plus == std::string_view::npos) {
-    error = "fault '" + std::string(text) +
-            "': expected KIND[:OUTPUT]@START+DURATION (seconds), e.g. drop:lidar@5+2";
+  std::string_view kind;
+  faults::FaultWindow window;
+  if (!faults::parse_fault_text(text, "KIND[:OUTPUT]@START+DURATION (seconds), e.g. drop:lidar@5+2",
+                                kind, window, error)) {
     return false;
   }
-  std::string_view kind = text.substr(0, at);
+  out.start_s = window.start_s;
+  out.duration_s = window.duration_s;
   std::string_view target = "all";
   if (const auto colon = kind.find(':'); colon != std::string_view::npos) {
     target = kind.substr(colon + 1);
@@ -81,12 +72,6 @@ bool parse_hil_fault(std::string_view text, HilFault& out, std::string& error) {
   if (!known_target) {
     error = "fault '" + std::string(text) + "': unknown output '" + std::string(target) +
             "' (outputs: lidar, imu, all)";
-    return false;
-  }
-  if (!parse_seconds(text.substr(at + 1, plus - at - 1), out.start_s) || out.start_s < 0 ||
-      !parse_seconds(text.substr(plus + 1), out.duration_s) || out.duration_s <= 0) {
-    error = "fault '" + std::string(text) +
-            "': start and duration must be seconds, start >= 0 and duration > 0";
     return false;
   }
   return true;
@@ -116,11 +101,7 @@ bool HilFaults::corrupt(double t_s, HilOutput output, std::span<std::byte> bytes
     covered = covered || (f.kind == HilFaultKind::kCorrupt && f.active(t_s) && f.applies(output));
   }
   if (!covered || bytes.empty()) return false;
-  std::uniform_int_distribution<std::size_t> where(0, bytes.size() - 1);
-  std::uniform_int_distribution<int> bit(0, 7);
-  for (std::size_t k = 0; k < std::max<std::size_t>(1, bytes.size() / 64); ++k) {
-    bytes[where(random_)] ^= static_cast<std::byte>(1u << bit(random_));
-  }
+  faults::flip_random_bits(bytes, random_);
   return true;
 }
 

@@ -1,12 +1,12 @@
 #include "tools/sim/fault_sink.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 
 #include "drivers/imu/a9_protocol.hpp"
 #include "drivers/velodyne/packet_format.hpp"
 #include "drivers/velodyne/position_packet.hpp"
+#include "tools/faults/fault_text.hpp"
 
 namespace posed::sim {
 
@@ -30,11 +30,6 @@ void put_u32(std::vector<std::byte>& b, std::size_t at, std::uint32_t v) {
 
 /// Where an A9 frame's µs counter sits: after sync, LEN and the u32 frame info.
 constexpr std::size_t kA9CounterOffset = 3 + 4;
-
-bool parse_seconds(std::string_view text, double& out) {
-  const auto r = std::from_chars(text.data(), text.data() + text.size(), out);
-  return r.ec == std::errc{} && r.ptr == text.data() + text.size() && std::isfinite(out);
-}
 
 }  // namespace
 
@@ -65,10 +60,8 @@ std::string_view to_string(FaultKind kind) {
 }
 
 std::string to_string(const Fault& fault) {
-  char text[96];
-  std::snprintf(text, sizeof text, "%s@%g+%g", std::string(to_string(fault.kind)).c_str(),
-                fault.start_s, fault.duration_s);
-  return text;
+  return std::string(to_string(fault.kind)) +
+         faults::window_text({fault.start_s, fault.duration_s});
 }
 
 std::string fault_kind_names() {
@@ -78,14 +71,12 @@ std::string fault_kind_names() {
 }
 
 bool parse_fault(std::string_view text, Fault& out, std::string& error) {
-  const auto at = text.find('@');
-  const auto plus = text.find('+', at == std::string_view::npos ? 0 : at);
-  if (at == std::string_view::npos || plus == std::string_view::npos) {
-    error = "fault '" + std::string(text) + "': expected KIND@START+DURATION (seconds), e.g. " +
-            "lidar_outage@30+5";
+  std::string_view name;
+  faults::FaultWindow window;
+  if (!faults::parse_fault_text(text, "KIND@START+DURATION (seconds), e.g. lidar_outage@30+5", name,
+                                window, error)) {
     return false;
   }
-  const std::string_view name = text.substr(0, at);
   bool known = false;
   for (const FaultKind k : kKinds) {
     if (to_string(k) == name) {
@@ -98,12 +89,8 @@ bool parse_fault(std::string_view text, Fault& out, std::string& error) {
             "' (kinds: " + fault_kind_names() + ")";
     return false;
   }
-  if (!parse_seconds(text.substr(at + 1, plus - at - 1), out.start_s) || out.start_s < 0 ||
-      !parse_seconds(text.substr(plus + 1), out.duration_s) || out.duration_s <= 0) {
-    error = "fault '" + std::string(text) +
-            "': start and duration must be seconds, start >= 0 and duration > 0";
-    return false;
-  }
+  out.start_s = window.start_s;
+  out.duration_s = window.duration_s;
   return true;
 }
 
@@ -241,11 +228,7 @@ bool FaultSink::write_raw(int stream, HostTime host_time, std::span<const std::b
     }
   }
   if (corrupt && !out.empty()) {
-    std::uniform_int_distribution<std::size_t> where(0, out.size() - 1);
-    std::uniform_int_distribution<int> bit(0, 7);
-    for (std::size_t k = 0; k < std::max<std::size_t>(1, out.size() / 64); ++k) {
-      out[where(random_)] ^= static_cast<std::byte>(1u << bit(random_));
-    }
+    faults::flip_random_bits(out, random_);
     ++count.corrupted;
   }
   Held& held = held_[i];
