@@ -130,6 +130,11 @@ int run_sim(int argc, char** argv) {
   app.add_flag("--realsense-imu", rsimu,
                "also the D435i's own IMU (accel 250 Hz, gyro 200 Hz as IIO HID records), the A9's "
                "backup (as config realsense_imu.enabled: true)");
+  bool dynamic = false;
+  app.add_flag("--dynamic", dynamic,
+               "people walking beside the robot's path with it and against it, and on the street "
+               "vehicles in the next lane, seen by every sensor (tools/sim/moving_objects.hpp); "
+               "listed in the recording's metadata");
   app.add_option("--thermal-format", thermal_format,
                  "thermal output: y8 (8-bit video after AGC, as M2DGR) or y16 (raw counts); "
                  "default: the config's thermal_camera.format")
@@ -190,6 +195,7 @@ int run_sim(int argc, char** argv) {
   options.visible_camera = options.thermal_camera = !no_cameras;
   options.depth_camera = !no_cameras && (depth || loaded.config.depth_camera.enabled);
   options.realsense_imu = rsimu || loaded.config.realsense_imu.enabled;
+  options.dynamic = dynamic;
   options.noise = !no_noise;
   std::string error;
   // Built here too for what the recording's metadata says of it (run_simulation builds its own).
@@ -239,6 +245,10 @@ int run_sim(int argc, char** argv) {
     std::string list;
     for (const sim::Fault& f : faults) list += (list.empty() ? "" : ",") + sim::to_string(f);
     ropt.metadata[std::string(sim::kSimMetadataName)]["faults"] = list;
+  }
+  if (dynamic) {
+    // Moving people and vehicles (their number; where they are follows from the seed).
+    ropt.metadata[std::string(sim::kSimMetadataName)]["dynamic"] = "true";
   }
   if (miscalibration) {
     // How the simulated rig differs from the configured one (true = configured · error).
@@ -316,6 +326,9 @@ int run_sim(int argc, char** argv) {
       static_cast<unsigned long long>(counters.messages_written),
       static_cast<double>(counters.bytes_on_disk) / 1e6, gt_path.empty() ? "" : "; ground truth ",
       gt_path.c_str());
+  if (!summary.moving_objects.empty()) {
+    std::printf("  moving  %s\n", summary.moving_objects.c_str());
+  }
   if (options.realsense_imu) {
     std::printf("  D435i IMU  %llu accel and %llu gyro records\n",
                 static_cast<unsigned long long>(summary.realsense_accel_records),

@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 
+#include "tools/sim/moving_objects.hpp"
+
 namespace posed::sim {
 namespace {
 
@@ -103,7 +105,9 @@ void DepthCamera::emit(std::vector<std::byte>& out, DepthFrameTruth* truth) {
   const World& world = scene_.world;
   const Eigen::Isometry3d T_map_depth =
       scene_.trajectory.T_map_base(schedule_.true_time(index_)) * config_.T_base_depth;
+  if (scene_.moving != nullptr) scene_.moving->place(schedule_.true_time(index_));
   render_gbuffer(world, scene_.bvh, rays_, T_map_depth, 150.0, gbuffer_);
+  if (scene_.moving != nullptr) scene_.moving->overlay(rays_, T_map_depth, 150.0, gbuffer_);
   const int W = gbuffer_.width, H = gbuffer_.height;
   const auto N = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
   z_m_.resize(N);

@@ -7,6 +7,7 @@
 
 #include "drivers/velodyne/position_packet.hpp"
 #include "drivers/velodyne/sensor_model.hpp"
+#include "tools/sim/moving_objects.hpp"
 #include "tools/sim/vlp32c_encoder.hpp"
 
 namespace posed::sim {
@@ -95,6 +96,7 @@ void LidarModel::emit_data(std::span<std::byte> out, LidarPacketTruth* truth) {
     const Duration t_true = clock_.true_at(d);
     if (truth != nullptr) truth->firing_true_ns[f] = t_true.ns;
     const TrajectorySample s = scene_.trajectory.at(t_true);
+    if (scene_.moving != nullptr) scene_.moving->place(t_true);
     const Eigen::Matrix3d R_map_base = s.q_map_base.toRotationMatrix();
     const Eigen::Matrix3d R_map_lidar = R_map_base * R_base_lidar;
     const Eigen::Vector3d p_map_lidar = s.p_map_base_m + R_map_base * p_base_lidar;
@@ -116,7 +118,11 @@ void LidarModel::emit_data(std::span<std::byte> out, LidarPacketTruth* truth) {
       dir.normalize();
       const Eigen::Vector3d origin = p_map_lidar + v_map_lidar * dt + R_map_lidar * o_lidar;
       ++rays_;
-      const auto hit = scene_.bvh.cast(origin, dir, config_.max_range_m);
+      auto hit = scene_.bvh.cast(origin, dir, config_.max_range_m);
+      if (scene_.moving != nullptr) {
+        if (auto m = scene_.moving->cast(origin, dir, hit ? hit->t_m : config_.max_range_m))
+          hit = m;
+      }
       if (truth != nullptr) {
         truth->p_lidar_m[f][c] =
             hit ? Eigen::Vector3f((o_lidar + hit->t_m * d_lidar).cast<float>())

@@ -8,10 +8,15 @@
 
 namespace posed::sim {
 
+class MovingObjects;
+
 struct SensorScene {
   const World& world;
   const Bvh& bvh;
   const Trajectory& trajectory;
+  /// people and vehicles (--dynamic): each sensor places them at its sample time, casts against
+  /// them besides the BVH; null without
+  MovingObjects* moving = nullptr;
 };
 
 }  // namespace posed::sim

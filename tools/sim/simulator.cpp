@@ -12,6 +12,7 @@
 #include "drivers/velodyne/position_packet.hpp"
 #include "tools/sim/bvh.hpp"
 #include "tools/sim/lidar_model.hpp"
+#include "tools/sim/moving_objects.hpp"
 #include "tools/sim/scenarios.hpp"
 #include "tools/sim/visible_camera.hpp"
 
@@ -135,9 +136,17 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
   if (!scenario) return false;
   const Trajectory& trajectory = scenario->trajectory;
   const Bvh bvh(scenario->world);
-  const SensorScene scene{scenario->world, bvh, trajectory};
+  // People and vehicles (--dynamic): appended to the world after its BVH, placed by each sensor
+  // at its sample time. Their own RNG, so the static world and every other draw stay the seed's.
+  std::optional<MovingObjects> moving;
+  if (options.dynamic) {
+    moving.emplace(scenario->world, trajectory, options.scenario == "street_night",
+                   options.seed ^ 0xD7A41C0B7EC75ull);
+  }
+  const SensorScene scene{scenario->world, bvh, trajectory, moving ? &*moving : nullptr};
   summary = {};
   summary.boxes = scenario->world.boxes.size();
+  if (moving) summary.moving_objects = moving->describe();
   summary.path_length_m = trajectory.path().length();
   summary.host_to_wall_ns = kSimWallStartNs - options.host_epoch_ns;
 

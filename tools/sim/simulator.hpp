@@ -79,6 +79,8 @@ struct SimOptions {
   bool depth_camera = false;
   /// the D435i's IMU (accel and gyro over IIO HID; the A9's backup), off unless asked for
   bool realsense_imu = false;
+  /// people and vehicles moving through the world (tools/sim/moving_objects.hpp)
+  bool dynamic = false;
   /// false: ideal sensors (no noise, no jitter, no dropouts); geometry stays the same
   bool noise = true;
   /// ground-truth pose rate [Hz]
@@ -90,6 +92,8 @@ struct SimOptions {
 struct SimSummary {
   std::uint64_t lidar_packets = 0, position_packets = 0, imu_frames = 0;
   std::uint64_t visible_frames = 0, thermal_frames = 0, depth_frames = 0, ground_truth_poses = 0;
+  /// with SimOptions::dynamic: "N people, M vehicles"
+  std::string moving_objects;
   /// D435i IMU records, accel and gyro
   std::uint64_t realsense_accel_records = 0, realsense_gyro_records = 0;
   /// lidar rays cast / returns encoded

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "tools/sim/moving_objects.hpp"
+
 namespace posed::sim {
 
 std::string_view to_string(ThermalFormat f) { return f == ThermalFormat::kY16 ? "y16" : "y8"; }
@@ -51,7 +53,9 @@ Duration ThermalCamera::next_send() const { return schedule_.true_time(index_); 
 void ThermalCamera::render_temperatures(Duration t) {
   const World& world = scene_.world;
   const Eigen::Isometry3d T_map_cam = scene_.trajectory.T_map_base(t) * config_.T_base_cam;
+  if (scene_.moving != nullptr) scene_.moving->place(t);
   render_gbuffer(world, scene_.bvh, rays_, T_map_cam, 150.0, gbuffer_);
+  if (scene_.moving != nullptr) scene_.moving->overlay(rays_, T_map_cam, 150.0, gbuffer_);
   const int w = gbuffer_.width, h = gbuffer_.height;
   temperature_.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
   const Eigen::Matrix3d R = T_map_cam.linear();

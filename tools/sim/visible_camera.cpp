@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "tools/sim/moving_objects.hpp"
+
 namespace posed::sim {
 
 VisibleCamera::VisibleCamera(const VisibleCameraConfig& config, const SensorScene& scene,
@@ -44,7 +46,9 @@ void VisibleCamera::emit(std::vector<std::byte>& out) {
   const World& world = scene_.world;
   const Duration t_true = schedule_.true_time(index_);
   const Eigen::Isometry3d T_map_cam = scene_.trajectory.T_map_base(t_true) * config_.T_base_cam;
+  if (scene_.moving != nullptr) scene_.moving->place(t_true);
   render_gbuffer(world, scene_.bvh, rays_, T_map_cam, 150.0, gbuffer_);
+  if (scene_.moving != nullptr) scene_.moving->overlay(rays_, T_map_cam, 150.0, gbuffer_);
   const Eigen::Vector3d o = T_map_cam.translation();
   // Lights that matter for this frame: the 8 nearest within 40 m, in float for the pixel loop
   // (positions relative to the camera: millimetres of float rounding at 40 m light nothing).
