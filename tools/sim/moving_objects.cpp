@@ -10,8 +10,8 @@ namespace {
 
 constexpr double kPersonHalf[3] = {0.15, 0.25, 0.875};  // along, across, up [m]
 constexpr double kVehicleHalf[3] = {2.2, 0.9, 0.75};    // [m]
-constexpr double kPeoplePer100m = 4.0;
-constexpr double kVehiclesPer100m = 2.0;
+constexpr double kPeoplePer100m = 10.0;
+constexpr double kVehiclesPer100m = 4.0;
 
 }  // namespace
 
