@@ -1,12 +1,13 @@
 #pragma once
 // `posectl sim --dynamic`: people and vehicles moving through the world, seen by every sensor.
-// They walk or drive along the robot's loop, beside it, with it or against it (people 0.9 m to
-// either side of its path at 0.7-1.6 m/s; on the street, vehicles in the lane beside it at
-// 3-9 m/s), so each passes the robot or is passed by it. Their boxes are appended to the world
-// after the static BVH was built (which never returns them): every sensor places them at its
-// own sample time (place()) before it casts, and tests them itself (cast(), overlay()). A
-// person is 0.5 x 0.3 x 1.75 m at 30 °C (clothes over skin), a vehicle 4.4 x 1.8 x 1.5 m, its
-// body at 35 °C; both reflect, texture and shade as the world's materials do.
+// People walk along the robot's loop beside its path, with it or against it (10 per 100 m of
+// loop, 0.9 m to either side, 0.7-1.6 m/s); on the street, vehicles drive in the lane beside it
+// (4 per 100 m, 3-9 m/s), so each passes the robot or is passed by it. Their boxes are appended
+// to the world after the static BVH was built (which never returns them): every sensor places
+// them at its own sample time (place()) before it casts, and tests them itself (cast(),
+// overlay()). A person is 0.3 x 0.5 x 1.75 m at 30 °C (clothes over skin), a vehicle 4.4 x 1.8 x
+// 1.5 m, its body at 35 °C; both reflect, texture and shade as the world's materials do. They
+// cast no shadows, and pass through each other and through anything static in their way.
 
 #include <Eigen/Geometry>
 #include <cstdint>
