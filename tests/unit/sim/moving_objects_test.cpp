@@ -34,7 +34,9 @@ TEST(MovingObjects, MoveAlongTheLoopOnTheGroundAndAreWhatRaysAndPixelsMeet) {
     ASSERT_TRUE(hit);
     EXPECT_GE(hit->box, static_boxes);
     EXPECT_LE(hit->t_m, 2.5 - b.half_extent_m.z() + 1e-9);
-    if (hit->box == k) EXPECT_NEAR(hit->t_m, 2.5 - b.half_extent_m.z(), 1e-9);
+    if (hit->box == k) {
+      EXPECT_NEAR(hit->t_m, 2.5 - b.half_extent_m.z(), 1e-9);
+    }
   }
   // One second later each has moved by about its speed (people 0.7-1.6 m/s, vehicles 3-9 m/s).
   moving.place(Duration::from_seconds(4.0));
