@@ -90,20 +90,25 @@ std::vector<std::byte> RealsenseImuModel::record(const Eigen::Vector3d& value_de
   return out;
 }
 
+void RealsenseImuModel::perturb(Eigen::Vector3d& v, Eigen::Vector3d& bias, double rate_hz,
+                                double random_walk, double noise_density) {
+  if (!config_.noise) return;
+  // Discrete equivalents of the continuous densities at the sample period dt: bias step
+  // sigma = walk * sqrt(dt), white sigma = density / sqrt(dt).
+  const double dt = 1.0 / rate_hz;
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int a = 0; a < 3; ++a) bias[a] += random_walk * std::sqrt(dt) * n(rng_);
+  for (int a = 0; a < 3; ++a) v[a] += bias[a] + noise_density / std::sqrt(dt) * n(rng_);
+}
+
 std::vector<std::byte> RealsenseImuModel::emit_accel() {
   const Duration t = accel_schedule_.true_time(accel_index_);
   const DeviceTime d = accel_schedule_.device(accel_index_);
   ++accel_index_;
   Eigen::Vector3d w, f;
   truth_at(t, w, f);
-  if (config_.noise) {
-    const double dt = 1.0 / config_.accel_rate_hz;
-    std::normal_distribution<double> n(0.0, 1.0);
-    for (int a = 0; a < 3; ++a)
-      accel_bias_[a] += config_.accel_random_walk * std::sqrt(dt) * n(rng_);
-    for (int a = 0; a < 3; ++a)
-      f[a] += accel_bias_[a] + config_.accel_noise_density / std::sqrt(dt) * n(rng_);
-  }
+  perturb(f, accel_bias_, config_.accel_rate_hz, config_.accel_random_walk,
+          config_.accel_noise_density);
   return record(f, kAccelLsb, d);
 }
 
@@ -113,13 +118,8 @@ std::vector<std::byte> RealsenseImuModel::emit_gyro() {
   ++gyro_index_;
   Eigen::Vector3d w, f;
   truth_at(t, w, f);
-  if (config_.noise) {
-    const double dt = 1.0 / config_.gyro_rate_hz;
-    std::normal_distribution<double> n(0.0, 1.0);
-    for (int a = 0; a < 3; ++a) gyro_bias_[a] += config_.gyro_random_walk * std::sqrt(dt) * n(rng_);
-    for (int a = 0; a < 3; ++a)
-      w[a] += gyro_bias_[a] + config_.gyro_noise_density / std::sqrt(dt) * n(rng_);
-  }
+  perturb(w, gyro_bias_, config_.gyro_rate_hz, config_.gyro_random_walk,
+          config_.gyro_noise_density);
   return record(w, kGyroLsb, d);
 }
 

@@ -62,6 +62,9 @@ class RealsenseImuModel {
  private:
   std::vector<std::byte> record(const Eigen::Vector3d& value_depth, double lsb,
                                 DeviceTime stamp) const;
+  /// With noise: `bias` walks one sample period at `rate_hz`, then `v` gets it and white noise.
+  void perturb(Eigen::Vector3d& v, Eigen::Vector3d& bias, double rate_hz, double random_walk,
+               double noise_density);
 
   RealsenseImuModelConfig config_;
   const Trajectory& trajectory_;
