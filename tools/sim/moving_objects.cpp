@@ -33,34 +33,29 @@ MovingObjects::MovingObjects(World& world, const Trajectory& trajectory, bool ve
                                         Eigen::Vector3d(u(0.3, 1), u(0.3, 1), u(0.3, 1))}));
   }
   first_box_ = world.boxes.size();
-  const auto n_people =
-      static_cast<std::size_t>(std::max(2.0, std::round(kPeoplePer100m * loop_m / 100.0)));
-  for (std::size_t k = 0; k < n_people; ++k) {
-    Object o;
-    o.u0_m = u(0, loop_m);
-    o.speed_mps = (u(0, 1) < 0.5 ? -1 : 1) * u(0.7, 1.6);
-    o.lateral_m = (u(0, 1) < 0.5 ? -1 : 1) * 0.9;
-    o.half_height_m = kPersonHalf[2];
-    objects_.push_back(o);
-    world.add_yawed(Eigen::Vector3d::Zero(),
-                    Eigen::Vector3d(kPersonHalf[0], kPersonHalf[1], kPersonHalf[2]), 0,
-                    clothes[static_cast<std::size_t>(u(0, 3.999))]);
-  }
-  people_ = objects_.size();
-  if (vehicles) {
-    const auto n =
-        static_cast<std::size_t>(std::max(1.0, std::round(kVehiclesPer100m * loop_m / 100.0)));
+  // n objects of one kind, each somewhere on the loop, with the robot or against it, `lateral_m`
+  // to its left (or, `either_side`, to its left or right).
+  const auto add = [&](std::size_t n, double min_speed_mps, double max_speed_mps, double lateral_m,
+                       bool either_side, const double(&half_m)[3],
+                       const std::vector<std::uint32_t>& materials) {
     for (std::size_t k = 0; k < n; ++k) {
       Object o;
       o.u0_m = u(0, loop_m);
-      o.speed_mps = (u(0, 1) < 0.5 ? -1 : 1) * u(3, 9);
-      o.lateral_m = 3.2;  // the next lane, left of the robot's
-      o.half_height_m = kVehicleHalf[2];
+      o.speed_mps = (u(0, 1) < 0.5 ? -1 : 1) * u(min_speed_mps, max_speed_mps);
+      o.lateral_m = either_side ? (u(0, 1) < 0.5 ? -1 : 1) * lateral_m : lateral_m;
       objects_.push_back(o);
-      world.add_yawed(Eigen::Vector3d::Zero(),
-                      Eigen::Vector3d(kVehicleHalf[0], kVehicleHalf[1], kVehicleHalf[2]), 0,
-                      paint[static_cast<std::size_t>(u(0, 2.999))]);
+      world.add_yawed(
+          Eigen::Vector3d::Zero(), Eigen::Vector3d(half_m[0], half_m[1], half_m[2]), 0,
+          materials[static_cast<std::size_t>(u(0, static_cast<double>(materials.size()) - 0.001))]);
     }
+  };
+  add(static_cast<std::size_t>(std::max(2.0, std::round(kPeoplePer100m * loop_m / 100.0))), 0.7,
+      1.6, 0.9, true, kPersonHalf, clothes);
+  people_ = objects_.size();
+  if (vehicles) {
+    // In the next lane, left of the robot's.
+    add(static_cast<std::size_t>(std::max(1.0, std::round(kVehiclesPer100m * loop_m / 100.0))), 3,
+        9, 3.2, false, kVehicleHalf, paint);
   }
   place(Duration::from_ns(0));
 }
@@ -75,7 +70,7 @@ void MovingObjects::place(Duration t) {
     const Eigen::Vector2d left(-tangent.y(), tangent.x());
     const Eigen::Vector2d at = p + o.lateral_m * left;
     Box& b = world_.boxes[first_box_ + k];
-    b.center_m = Eigen::Vector3d(at.x(), at.y(), o.half_height_m);
+    b.center_m = Eigen::Vector3d(at.x(), at.y(), b.half_extent_m.z());  // on the ground
     const double yaw = std::atan2(tangent.y(), tangent.x()) + (o.speed_mps < 0 ? M_PI : 0.0);
     b.R_map_box = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   }

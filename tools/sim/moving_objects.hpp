@@ -51,7 +51,6 @@ class MovingObjects {
     double u0_m = 0;       ///< position along the loop at t = 0 [m]
     double speed_mps = 0;  ///< along the loop; negative: against the robot's direction
     double lateral_m = 0;  ///< to the left of the path (+) or right (-) [m]
-    double half_height_m = 0;
   };
   World& world_;
   const Trajectory& trajectory_;
