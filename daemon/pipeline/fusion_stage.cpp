@@ -157,8 +157,8 @@ void FusionStage::run() {
   Lane<ImuItem> backup_imu(inputs_.backup_imu);
 
   // Which lane goes next: the oldest head; on equal stamps the IMU first (a scan or frame ending
-  // exactly at an IMU sample finds it already in the core), then scans, visible, thermal. Stamp
-  // order waits for every open lane.
+  // exactly at an IMU sample finds it already in the core), then scans, visible, thermal, and
+  // the D435i's IMU (used only in a silent A9's place). Stamp order waits for every open lane.
   enum class Next { kNone, kImu, kScan, kVisible, kThermal, kBackupImu };
   const auto next = [&] {
     imu.refill();
