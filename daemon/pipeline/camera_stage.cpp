@@ -97,7 +97,8 @@ void CameraStage::handle_frame(const drivers::RawChunk& chunk, std::span<const s
   }
   image.stamp = stamp;
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
-  const PushResult r = queue_.push(ImageItem{std::move(image), false, chunk.host_receive});
+  const PushResult r =
+      queue_.push(ImageItem{std::move(image), false, chunk.host_receive, counters_.bad()});
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   consumer_.signal();
 }

@@ -109,8 +109,26 @@ void FusionStage::took(std::size_t stream, const Item& item) {
   heard_[stream] = true;
   counters_.newest_stamp_by_stream_ns[stream].store(stream_stamp_[stream].ns,
                                                     std::memory_order_relaxed);
-  if (!in_stamp_order_) return;  // live: the host clock judges silence (fill_stream_status())
+  // Live, the host clock judges silence and bad samples (fill_stream_status()).
+  if (!in_stamp_order_) return;
+  if (item.bad_before > bad_seen_[stream]) {
+    bad_seen_[stream] = item.bad_before;
+    bad_rose_[stream] = stamp;
+    if (!degraded_[stream]) {
+      degraded_[stream] = true;
+      counters_.degraded_by_stream[stream].store(true, std::memory_order_relaxed);
+      POSED_LOG_WARN("stream %s: ok -> degraded at %.3f s (%llu malformed or dropped so far)",
+                     kNames[stream], stamp.seconds(),
+                     static_cast<unsigned long long>(item.bad_before));
+    }
+  }
   for (std::size_t s = 0; s < kStreams; ++s) {
+    if (degraded_[s] && newest_stamp_ - bad_rose_[s] > kStreamDegradedFor) {
+      degraded_[s] = false;
+      counters_.degraded_by_stream[s].store(false, std::memory_order_relaxed);
+      POSED_LOG_NOTICE("stream %s: degraded -> ok at %.3f s", kNames[s],
+                       (bad_rose_[s] + kStreamDegradedFor).seconds());
+    }
     if (!heard_[s] || silent_[s] || newest_stamp_ - stream_stamp_[s] <= kStreamStaleAfter) {
       continue;
     }

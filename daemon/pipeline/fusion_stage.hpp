@@ -44,6 +44,9 @@ struct FusionCounters {
   /// realsense_imu [ns]. A replay's stream health: merged in stamp order, a stream that fell
   /// silent shows as the merge passing it by.
   std::atomic<std::int64_t> newest_stamp_by_stream_ns[5] = {0, 0, 0, 0, 0};
+  /// per stream, in stamp order (replays only): a malformed or dropped sample came before one
+  /// the merge took within kStreamDegradedFor of its newest stamp
+  std::atomic<bool> degraded_by_stream[5] = {false, false, false, false, false};
   /// the D435i IMU standing in for the A9 (imu_failover.hpp): now, how often, how many samples
   std::atomic<bool> imu_on_backup{false};
   std::atomic<std::uint64_t> imu_failovers{0};
@@ -127,7 +130,8 @@ class FusionStage {
   /// The core took `item` of `stream` (0..4: imu, lidar, visible, thermal, realsense_imu): the
   /// newest stamps and receive time move on and, in stamp order, that stream is heard again if it
   /// was silent, and every stream the merge has passed by more than kStreamStaleAfter falls silent;
-  /// both logged with the data's time.
+  /// a stream whose item counts more bad samples before it than the last is degraded until the
+  /// merge has passed that by kStreamDegradedFor; all logged with the data's time.
   template <class Item>
   void took(std::size_t stream, const Item& item);
   static constexpr std::size_t kStreams = 5;
@@ -137,6 +141,11 @@ class FusionStage {
   HostTime stream_stamp_[kStreams];
   /// per stream, in stamp order: the merge has passed its newest stamp by kStreamStaleAfter
   bool silent_[kStreams] = {false, false, false, false, false};
+  /// per stream, in stamp order: the bad count the newest item carried (Item::bad_before), when
+  /// it last rose, and whether that is within kStreamDegradedFor of the merge
+  std::uint64_t bad_seen_[kStreams] = {0, 0, 0, 0, 0};
+  HostTime bad_rose_[kStreams];
+  bool degraded_[kStreams] = {false, false, false, false, false};
   /// which IMU feeds the core, decided in data order
   ImuFailover failover_;
 };

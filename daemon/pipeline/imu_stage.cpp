@@ -50,7 +50,7 @@ void ImuStage::on_a9_frame(const a9::A9Frame& frame, HostTime arrival) {
 }
 
 void ImuStage::push(const ImuSample& sample) {
-  const PushResult r = queue_.push(ImuItem{sample, false, chunk_received_});
+  const PushResult r = queue_.push(ImuItem{sample, false, chunk_received_, counters_.bad()});
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);
   pushed_ = true;

@@ -64,7 +64,8 @@ void LidarStage::push_scan(LidarScan&& scan) {
   }
   scan_counters_.scans.fetch_add(1, std::memory_order_relaxed);
   scan_counters_.points.fetch_add(scan.point_count, std::memory_order_relaxed);
-  const PushResult r = queue_.push(ScanItem{std::move(scan), false, chunk_received_});
+  const PushResult r =
+      queue_.push(ScanItem{std::move(scan), false, chunk_received_, counters_.bad()});
   if (r == PushResult::kRejectedFull || r == PushResult::kRejectedTimeout ||
       r == PushResult::kPushedDropped) {
     counters_.dropped.fetch_add(1, std::memory_order_relaxed);

@@ -318,10 +318,12 @@ PipelineStatus Pipeline::status() const {
       sources_.imu->live()
           ? now
           : HostTime::from_ns(fusion_counters_->newest_stamp_ns.load(std::memory_order_relaxed));
-  const auto consumed = [&](std::size_t stream) -> std::optional<HostTime> {
+  const auto consumed = [&](std::size_t stream) -> std::optional<MergedStreamHealth> {
     if (sources_.imu->live()) return std::nullopt;
-    return HostTime::from_ns(
-        fusion_counters_->newest_stamp_by_stream_ns[stream].load(std::memory_order_relaxed));
+    return MergedStreamHealth{
+        HostTime::from_ns(
+            fusion_counters_->newest_stamp_by_stream_ns[stream].load(std::memory_order_relaxed)),
+        fusion_counters_->degraded_by_stream[stream].load(std::memory_order_relaxed)};
   };
   std::lock_guard health_lock(health_mutex_);
   PipelineStatus st;

@@ -19,7 +19,7 @@ ClockSyncStatus StreamCounters::clock() const {
 
 void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
                         const drivers::Source& source, HostTime now, StreamHealthMemory& memory,
-                        std::optional<HostTime> newest_arrival) {
+                        std::optional<MergedStreamHealth> merged) {
   out.received = counters.received.load(std::memory_order_relaxed);
   out.refused = source.counters().rejected;
   out.decoded = counters.decoded.load(std::memory_order_relaxed);
@@ -31,14 +31,15 @@ void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
   out.clock_drift_ppm = clock.drift_ppm;
   out.clock_jitter_ns = static_cast<double>(clock.jitter.ns);
   out.clock_uncertainty_ns = static_cast<double>(clock.uncertainty.ns);
-  const Duration silent = now - newest_arrival.value_or(clock.last_arrival);
+  const Duration silent = now - (merged ? merged->newest_stamp : clock.last_arrival);
   const bool stale = clock.samples == 0 || silent > kStreamStaleAfter;
   out.clock_state =
       std::string(to_string(stale && clock.samples > 0 ? SyncState::kLost : clock.state));
   const std::uint64_t bad = out.malformed + out.dropped;
   if (bad > memory.bad) memory.bad_rose = now;
   memory.bad = bad;
-  const bool recently_bad = memory.bad_rose && now - *memory.bad_rose <= kStreamDegradedFor;
+  const bool recently_bad =
+      merged ? merged->degraded : memory.bad_rose && now - *memory.bad_rose <= kStreamDegradedFor;
   if (counters.device_lost.load(std::memory_order_relaxed)) {
     out.health = "device_lost";
   } else if (out.decoded == 0 || stale) {
@@ -49,10 +50,9 @@ void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
     out.health = "ok";
   }
   // Not the first data (no_data -> ok at start-up is no news), but every change after it. A
-  // replay's silences are logged by the fusion stage, exactly in the data's time (a report
+  // replay's changes are logged by the fusion stage, exactly in the data's time (a report
   // sampled on the wall clock can miss one: a replay catches up on a silence at once).
-  const bool silence_change = out.health == "no_data" || memory.last_health == "no_data";
-  if (out.health != memory.last_health && memory.had_data && !(silence_change && newest_arrival)) {
+  if (out.health != memory.last_health && memory.had_data && !merged) {
     // The journal's record of a stream failing and coming back, in the data's time.
     char why[96] = "";
     if (out.health == "no_data" && clock.samples > 0) {

@@ -33,16 +33,25 @@ struct ImuItem {
   ImuSample sample;
   bool end_of_stream = false;
   HostTime received;
+  /// its stage's malformed + dropped count when it was queued (StreamCounters::bad()): a replay's
+  /// health judges bad samples where the merge is, not where the stage has read ahead to
+  std::uint64_t bad_before = 0;
 };
 struct ScanItem {
   LidarScan scan;
   bool end_of_stream = false;
   HostTime received;
+  /// its stage's malformed + dropped count when it was queued (StreamCounters::bad()): a replay's
+  /// health judges bad samples where the merge is, not where the stage has read ahead to
+  std::uint64_t bad_before = 0;
 };
 struct ImageItem {
   Image image;
   bool end_of_stream = false;
   HostTime received;
+  /// its stage's malformed + dropped count when it was queued (StreamCounters::bad()): a replay's
+  /// health judges bad samples where the merge is, not where the stage has read ahead to
+  std::uint64_t bad_before = 0;
 };
 struct StateItem {
   NavState state;
@@ -71,6 +80,12 @@ struct StreamCounters {
   std::atomic<std::uint64_t> dropped{0};      ///< measurements lost to a full queue or pool
   std::atomic<std::uint64_t> undecodable{0};  ///< chunks of a wire format no decoder knows
   std::atomic<bool> device_lost{false};
+
+  /// Everything that counts against the stream's health: malformed, undecodable and dropped.
+  std::uint64_t bad() const {
+    return malformed.load(std::memory_order_relaxed) + undecodable.load(std::memory_order_relaxed) +
+           dropped.load(std::memory_order_relaxed);
+  }
 
   /// The clock figures, copied from the stage's ClockSync now and then.
   void publish_clock(const ClockSyncStatus& clock);
@@ -102,13 +117,20 @@ inline constexpr Duration kStreamDegradedFor = Duration::from_s(2);
 /// host's clock for a live Source, the newest sample of any stream in a replay (its data's
 /// clock, whatever the replay speed), so silence and bad samples mean the same in both.
 /// Health: device_lost; no_data (nothing decoded, or silent for kStreamStaleAfter); degraded
-/// (malformed or dropped samples within kStreamDegradedFor); ok. A change of health is logged.
-/// `newest_arrival`: the stream's newest stamp the fusion core took (a replay: the merge in stamp
-/// order waits for a silent stream, so only the merge passing it by shows the silence; `now` is
-/// then the merge's stamp); unset: its clock sync's newest arrival (live).
+/// (malformed or dropped samples within kStreamDegradedFor); ok. Live, a change of health is
+/// logged here.
+/// `merged`: a replay's view from the fusion core's merge in stamp order (`now` is then the
+/// merge's stamp): the merge waits for a silent stream, so only the merge passing it by shows
+/// the silence, and a stage reads ahead of the merge, so its bad samples count from where the
+/// merge takes the items they came before. The fusion stage logs those changes, exactly in the
+/// data's time. Unset (live): the stream's clock sync's newest arrival and the stage's counts.
+struct MergedStreamHealth {
+  HostTime newest_stamp;  ///< the stream's newest stamp the fusion core took
+  bool degraded = false;  ///< FusionCounters::degraded_by_stream
+};
 void fill_stream_status(StreamStatus& out, const StreamCounters& counters,
                         const drivers::Source& source, HostTime now, StreamHealthMemory& memory,
-                        std::optional<HostTime> newest_arrival = std::nullopt);
+                        std::optional<MergedStreamHealth> merged = std::nullopt);
 
 /// The bookkeeping every source stage does around Source::read(): heartbeat, the device lost and
 /// back (logged once per transition), the received count, and chunks of a wire format the stage

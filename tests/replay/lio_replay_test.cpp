@@ -238,6 +238,24 @@ TEST(LioReplay, ABurstOfCorruptLidarPacketsDoesNotStopTheLidar) {
   ASSERT_EQ(posed.wait_for_exit(120s), 0) << posed.err();
   // The lidar is heard again after the burst, and poses follow the scans to the end.
   EXPECT_EQ(posed.err().find("stream lidar: ok -> no_data"), std::string::npos) << posed.err();
+  // Both streams are degraded in the data's time: from the first good sample after a bad one
+  // (where the merge meets it, not where the stage had read ahead to: the IMU's reads seconds
+  // ahead) until 2 s after the last. The lidar's packets are damaged, not all lost: from the
+  // burst's first scan. Every A9 frame in the burst fails its CRC: the IMU is silent in it and
+  // degraded from its first good frame. posectl sim's host clock starts at 100 s.
+  const auto at = [&](const std::string& stream, const std::string& change) -> double {
+    const std::string log = posed.err(), line = "stream " + stream + ": " + change + " at ";
+    const auto i = log.find(line);
+    if (i == std::string::npos) return -1;
+    return std::stod(log.substr(i + line.size())) - 100.0;
+  };
+  EXPECT_GE(at("lidar", "ok -> degraded"), 4.0) << posed.err();
+  EXPECT_LE(at("lidar", "ok -> degraded"), 4.2) << posed.err();
+  EXPECT_GE(at("lidar", "degraded -> ok"), 6.0) << posed.err();
+  EXPECT_LE(at("lidar", "degraded -> ok"), 7.3) << posed.err();
+  EXPECT_GE(at("imu", "ok -> degraded"), 4.0) << posed.err();
+  EXPECT_LE(at("imu", "ok -> degraded"), 5.1) << posed.err();
+  EXPECT_NEAR(at("imu", "degraded -> ok") - at("imu", "ok -> degraded"), 2.0, 0.1) << posed.err();
   const auto poses = recorded_poses(dir.file("out.mcap"), "/posed/pose", false);
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   ASSERT_FALSE(truth.empty());

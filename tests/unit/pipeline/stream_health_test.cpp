@@ -37,12 +37,15 @@ struct Stream {
     clock.last_arrival = at(t);
     counters.publish_clock(clock);
   }
-  std::string health(double now, std::optional<double> newest = std::nullopt) {
+  /// Live without `newest`; a replay with it: the stream's newest stamp the merge took, and
+  /// whether the merge has passed a bad sample within the last two seconds.
+  std::string health(double now, std::optional<double> newest = std::nullopt,
+                     bool merged_degraded = false) {
     StreamStatus s;
     s.name = "lidar";
-    std::optional<HostTime> newest_arrival;
-    if (newest) newest_arrival = at(*newest);
-    fill_stream_status(s, counters, source, at(now), memory, newest_arrival);
+    std::optional<MergedStreamHealth> merged;
+    if (newest) merged = MergedStreamHealth{at(*newest), merged_degraded};
+    fill_stream_status(s, counters, source, at(now), memory, merged);
     return s.health;
   }
 };
@@ -81,6 +84,16 @@ TEST(StreamHealth, AReplayIsJudgedByTheNewestStampTheMergeTookNotTheStagesArriva
   EXPECT_EQ(stream.health(4.0, 3.5), "ok");       // ... the merge is at 4 s, this stream's at 3.5
   EXPECT_EQ(stream.health(4.6, 3.5), "no_data");  // passed by more than a second
   EXPECT_EQ(stream.health(4.7, 4.7), "ok");
+}
+
+TEST(StreamHealth, AReplaysBadSamplesCountWhereTheMergeIsNotWhereTheStageReadTo) {
+  // The stage read ahead to 10 s and counted malformed samples there; the merge, at 4 s, has not
+  // reached them: ok, until the fusion stage says the merge has passed one.
+  Stream stream;
+  stream.sample(10.0, 5);
+  EXPECT_EQ(stream.health(4.0, 4.0), "ok");
+  EXPECT_EQ(stream.health(9.9, 9.9, true), "degraded");
+  EXPECT_EQ(stream.health(12.0, 12.0), "ok");
 }
 
 }  // namespace
