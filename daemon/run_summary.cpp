@@ -9,6 +9,7 @@
 #include "daemon/foxglove/server.hpp"
 #include "daemon/image_output.hpp"
 #include "daemon/pipeline/pipeline.hpp"
+#include "daemon/resident_memory.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/recording/recorder.hpp"
 #include "drivers/synthetic/synthetic_imu_source.hpp"
@@ -29,6 +30,10 @@ bool print_run_summary(const RunSummary& r) {
   const double run_s = (drivers::host_now() - r.started).seconds();
   std::printf("\nposed summary\n");
   std::printf("  run time            %.1f s\n", run_s);
+  if (const ResidentMemory mem = read_resident_memory(); mem.peak_mb >= 0) {
+    std::printf("  memory              peak resident %.1f MB; heap and stacks %.1f MB at the end\n",
+                mem.peak_mb, mem.anon_mb);
+  }
   std::printf("  estimator           %s, last mode %s\n", r.pipe.estimator_description().c_str(),
               std::string(to_string(st.mode)).c_str());
   // The stream counts are the last --loop pass's: their rates are over its time.
