@@ -22,6 +22,7 @@ void LidarOdometry::reset() {
 
 void LidarOdometry::deskew(std::span<const LidarPoint> points, HostTime scan_start,
                            const ScanMotion& motion) {
+  scan_start_ = scan_start;
   lidar::deskew(points, scan_start, motion, config_.features.columns, config_.min_range_m,
                 config_.max_range_m, deskewed_);
 }
@@ -48,10 +49,10 @@ void LidarOdometry::add_to_map(const Eigen::Isometry3d& T, bool keyframe) {
   const Eigen::Isometry3f Tf = T.cast<float>();
   transformed_.clear();
   for (const Eigen::Vector3f& p : features_.edges) transformed_.push_back(Tf * p);
-  edge_map_.insert(transformed_);
+  edge_map_.insert(transformed_, scan_start_.ns);
   transformed_.clear();
   for (const Eigen::Vector3f& p : features_.planes) transformed_.push_back(Tf * p);
-  plane_map_.insert(transformed_);
+  plane_map_.insert(transformed_, scan_start_.ns);
   if (!keyframe) return;
   keyframes_.push_back(T);
   ++counters_.keyframes;

@@ -73,6 +73,7 @@ class LidarOdometry {
   FeatureExtractor extractor_;
   ScanMatcher matcher_;
   VoxelMap edge_map_, plane_map_;
+  HostTime scan_start_;  ///< of the scan deskew() took: when its points hit the map's voxels
   std::vector<ScanPoint> deskewed_;
   ScanFeatures features_;
   std::vector<Eigen::Vector3f> transformed_;

@@ -328,6 +328,9 @@ const Field kSchema[] = {
       "downsampling of edge lidar features"),
     F("estimator.map_radius_m", estimator.map_radius_m, "120", "m", 10, 2000, "",
       "the local map keeps what is within this distance of the robot"),
+    F("estimator.map_confirm_s", estimator.map_confirm_s, "0", "s", 0, 60, "",
+      "a local-map voxel is matched against only once scans have hit it over this long, so the "
+      "trail a moving person or vehicle leaves is not taken for the world (0: at once)"),
     F("estimator.keyframe_distance_m", estimator.keyframe_distance_m, "1", "m", 0.01, 100, "",
       "a scan this far from the last keyframe is a keyframe (exported map poses)"),
     F("estimator.keyframe_angle_deg", estimator.keyframe_angle_deg, "11.5", "deg", 0.1, 180, "",

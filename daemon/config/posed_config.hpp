@@ -211,11 +211,12 @@ struct EstimatorSection {
   double plane_voxel_m = 0.4;                    ///< planar features downsampling [m]
   double edge_voxel_m = 0.2;                     ///< edge features downsampling [m]
   double map_radius_m = 120;                     ///< local map kept around the robot [m]
-  double keyframe_distance_m = 1.0;              ///< keyframe spacing [m]
-  double keyframe_angle_deg = 11.5;              ///< keyframe spacing [deg]
-  std::string camera_coupling = "loose";         ///< loose (between factors) | off (front end only)
-  double camera_pixel_sigma_px = 1.0;            ///< Σ_base of a frame-to-frame motion [px]
-  bool camera_quality_weighting = true;          ///< Σ = ω Σ_base (seed 002); false: ω = 1
+  double map_confirm_s = 0;          ///< a map voxel is matched once scans hit it this long [s]
+  double keyframe_distance_m = 1.0;  ///< keyframe spacing [m]
+  double keyframe_angle_deg = 11.5;  ///< keyframe spacing [deg]
+  std::string camera_coupling = "loose";      ///< loose (between factors) | off (front end only)
+  double camera_pixel_sigma_px = 1.0;         ///< Σ_base of a frame-to-frame motion [px]
+  bool camera_quality_weighting = true;       ///< Σ = ω Σ_base (seed 002); false: ω = 1
   bool camera_residual_scaling = true;        ///< and by their disagreement with the other stream
   bool camera_thermal_gate_strict = true;     ///< thermal majority off the IMU's guess: no motion
   double camera_min_confidence = 0.05;        ///< a stream below it leaves the estimate [0..1]

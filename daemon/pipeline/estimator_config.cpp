@@ -40,6 +40,8 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.lidar.matcher.degeneracy_rotation_threshold_m2 = e.degeneracy_rotation_threshold_m2;
   l.lidar.matcher.degenerate_information_scale = e.degenerate_information_scale;
   l.lidar.map_radius_m = e.map_radius_m;
+  l.lidar.edge_map.confirm_after_s = e.map_confirm_s;
+  l.lidar.plane_map.confirm_after_s = e.map_confirm_s;
   l.lidar.keyframe_distance_m = e.keyframe_distance_m;
   l.lidar.keyframe_angle_rad = e.keyframe_angle_deg * kDeg;
   l.window.size = e.window_size;
