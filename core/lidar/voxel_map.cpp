@@ -57,6 +57,7 @@ void VoxelMap::insert(const std::vector<Eigen::Vector3f>& points_map, std::int64
     }
     Voxel& voxel = voxels_[it->second];
     std::vector<Eigen::Vector3f>& v = voxel.points;
+    if (confirm_s_ <= 0 && v.size() >= cap) continue;  // full, and nothing to confirm
     bool near = false;
     std::size_t stale = v.size();  // a point never found again within the span: transient
     for (std::size_t i = 0; i < v.size(); ++i) {
