@@ -152,6 +152,8 @@ struct RealsenseImuSection {
   double accel_rate_hz = 250;      ///< [Hz]
   double gyro_rate_hz = 200;       ///< [Hz]
   double clock_latency_s = 0;      ///< minimum transport latency, device stamp to arrival [s]
+  std::string sysfs_root = "/sys/bus/iio/devices";  ///< where the IIO devices are listed
+  std::string dev_dir = "/dev";                     ///< where their character devices are
 };
 
 struct SyncSection {

@@ -140,6 +140,10 @@ BuiltSources make_sources(const config::PosedConfig& config, std::string& error)
     drivers::camera::RealsenseImuSourceConfig rs;
     rs.accel.sampling_frequency_hz = config.realsense_imu.accel_rate_hz;
     rs.gyro.sampling_frequency_hz = config.realsense_imu.gyro_rate_hz;
+    for (drivers::camera::IioHidDeviceConfig* d : {&rs.accel, &rs.gyro}) {
+      d->sysfs_root = config.realsense_imu.sysfs_root;
+      d->dev_dir = config.realsense_imu.dev_dir;
+    }
     built.sources.realsense_imu =
         std::make_unique<drivers::camera::RealsenseImuSource>("realsense_imu", std::move(rs));
   }

@@ -42,6 +42,7 @@ bool RealsenseImuSource::open(std::string& error) {
     if (!enable_iio_hid_device(*configs[i], c.device, error)) {
       error = "imu " + name_ + ": " + error;
       close();
+      lost_ = true;  // read() looks for them again: a camera plugged in after start
       return false;
     }
     c.fd = ::open(c.device.dev_node.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -49,6 +50,7 @@ bool RealsenseImuSource::open(std::string& error) {
       error = "imu " + name_ + ": cannot open " + c.device.dev_node + ": " + std::strerror(errno);
       disable_iio_hid_device(c.device);
       close();
+      lost_ = true;
       return false;
     }
     c.wire_format = describe_iio_layout(prefixes[i], c.device.layout);
@@ -80,7 +82,7 @@ ReadStatus RealsenseImuSource::read(RawChunk& chunk, Duration timeout) {
   }
   const int timeout_ms = static_cast<int>(std::max<std::int64_t>(0, timeout.ns / 1'000'000));
   if (channels_[0].fd < 0) {
-    if (!lost_) return ReadStatus::kTimeout;  // never opened: nothing to read
+    if (!lost_) return ReadStatus::kTimeout;  // open() never called: nothing to read
     ::poll(nullptr, 0, std::min(timeout_ms, config_.reopen_interval_ms));
     std::string error;
     if (!open(error)) return ReadStatus::kDeviceLost;

@@ -23,6 +23,8 @@ std::string_view to_string(HilOutput output) {
       return "udp position";
     case HilOutput::kSerial:
       return "pty";
+    case HilOutput::kIio:
+      return "iio";
   }
   return "none";
 }
@@ -31,6 +33,10 @@ HilOutput output_for_wire_format(std::string_view wire_format) {
   if (wire_format == drivers::wire::kVelodyneData) return HilOutput::kUdpData;
   if (wire_format == drivers::wire::kVelodynePosition) return HilOutput::kUdpPosition;
   if (wire_format == drivers::wire::kA9Serial) return HilOutput::kSerial;
+  if (wire_format.starts_with(drivers::wire::kIioAccel3d) ||
+      wire_format.starts_with(drivers::wire::kIioGyro3d)) {
+    return HilOutput::kIio;
+  }
   return HilOutput::kNone;
 }
 
@@ -55,8 +61,21 @@ bool HilPlaylist::open(const HilPlaylistOptions& options, std::string& error) {
     h.source_channel =
         raw::parse_source_channel(raw::metadata_value(c.metadata, raw::kSourceChannelKey));
     h.output = output_for_wire_format(h.wire_format);
-    h.sent = h.output == HilOutput::kSerial ? options_.serial
-                                            : h.output != HilOutput::kNone && options_.udp;
+    switch (h.output) {
+      case HilOutput::kSerial:
+        h.sent = options_.serial;
+        break;
+      case HilOutput::kIio:
+        h.sent = options_.iio;
+        break;
+      case HilOutput::kUdpData:
+      case HilOutput::kUdpPosition:
+        h.sent = options_.udp;
+        break;
+      case HilOutput::kNone:
+        h.sent = false;
+        break;
+    }
     if (channel_index_.size() <= id) channel_index_.resize(id + 1u, -1);
     channel_index_[id] = static_cast<std::int64_t>(channels_.size());
     formats.insert(h.wire_format);
@@ -67,7 +86,8 @@ bool HilPlaylist::open(const HilPlaylistOptions& options, std::string& error) {
     for (const auto& f : formats) list += (list.empty() ? "" : ", ") + f;
     error = "mcap " + options_.path + ": no raw channel to re-emit (raw wire formats: " +
             (list.empty() ? std::string("none") : list) +
-            "; sent are velodyne-udp-data/-position over UDP and a9-serial on a pty)";
+            "; sent are velodyne-udp-data/-position over UDP, a9-serial on a pty and, with --iio, "
+            "the D435i's IMU as IIO devices)";
     return false;
   }
   return true;

@@ -4,6 +4,7 @@
 //   velodyne-udp-data      -> UDP data port        (HilOutput::kUdpData)
 //   velodyne-udp-position  -> UDP position port    (HilOutput::kUdpPosition)
 //   a9-serial              -> the pty              (HilOutput::kSerial)
+//   iio-hid-accel-3d/gyro  -> fake IIO devices     (HilOutput::kIio, only when asked)
 // merged across channels in log-time order, with --start/--duration/--loop applied. Channels of
 // other formats (camera frames, CAN) are listed with the reason they are not sent.
 //
@@ -23,7 +24,7 @@
 
 namespace posed::hil {
 
-enum class HilOutput : std::uint8_t { kNone, kUdpData, kUdpPosition, kSerial };
+enum class HilOutput : std::uint8_t { kNone, kUdpData, kUdpPosition, kSerial, kIio };
 
 std::string_view to_string(HilOutput output);
 /// The output a raw channel of `wire_format` goes to (kNone: no HIL output for it).
@@ -41,6 +42,8 @@ struct HilPlaylistOptions {
   /// leave out the UDP (lidar) or the serial (A9) outputs
   bool udp = true;
   bool serial = true;
+  /// the D435i's IMU onto IIO devices (IioEmitter): only when a directory for them is given
+  bool iio = false;
   /// how far out of log-time order the file may be [ns]
   Duration reorder_window = Duration::from_s(1);
 };

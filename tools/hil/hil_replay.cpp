@@ -25,6 +25,10 @@ bool HilReplay::open(std::string& error) {
     if (!c.sent) continue;
     need_udp = need_udp || c.output == HilOutput::kUdpData || c.output == HilOutput::kUdpPosition;
     need_pty = need_pty || c.output == HilOutput::kSerial;
+    if (c.output == HilOutput::kIio) {
+      if (!iio_) iio_ = std::make_unique<IioEmitter>(options_.iio_dir);
+      if (!iio_->add(c.wire_format, error)) return false;
+    }
   }
   if (need_udp) {
     udp_ = std::make_unique<UdpEmitter>(options_.udp);
@@ -47,6 +51,9 @@ void HilReplay::send(const HilMessage& m) {
       break;
     case HilOutput::kSerial:
       pty_->write(m.bytes);
+      break;
+    case HilOutput::kIio:
+      iio_->write(playlist_.channels()[m.channel].wire_format, m.bytes);
       break;
     case HilOutput::kNone:
       break;
@@ -142,6 +149,7 @@ HilReplayStatus HilReplay::status() const {
     s.udp_position = udp_->counters(1);
   }
   if (pty_) s.pty = pty_->counters();
+  if (iio_) s.iio = iio_->counters();
   std::lock_guard lock(mutex_);
   s.messages = messages_;
   s.lateness = lateness_;

@@ -14,6 +14,7 @@
 
 #include "tools/hil/hil_faults.hpp"
 #include "tools/hil/hil_playlist.hpp"
+#include "tools/hil/iio_emitter.hpp"
 #include "tools/hil/lateness_histogram.hpp"
 #include "tools/hil/pacer.hpp"
 #include "tools/hil/pty_emitter.hpp"
@@ -28,6 +29,8 @@ struct HilReplayOptions {
   UdpTarget udp;
   /// symlink to the pty ("" = none; the pty's own name is then the only way to it)
   std::string pty_link;
+  /// where the D435i's IMU goes as IIO devices (iio_emitter.hpp); with playlist.iio
+  std::string iio_dir;
   /// the schedule's first message is due this long after run() starts sending, so setup costs
   /// do not show as lateness
   Duration lead = Duration::from_ms(100);
@@ -37,12 +40,13 @@ struct HilReplayOptions {
 
 /// Outputs, in the order of HilReplayStatus::lateness.
 inline constexpr std::array kHilOutputs = {HilOutput::kUdpData, HilOutput::kUdpPosition,
-                                           HilOutput::kSerial};
+                                           HilOutput::kSerial, HilOutput::kIio};
 
 struct HilReplayStatus {
   UdpChannelCounters udp_data;
   UdpChannelCounters udp_position;
   PtyCounters pty;
+  IioCounters iio;
   /// messages handed to each output of kHilOutputs (sent or not)
   std::array<std::uint64_t, kHilOutputs.size()> messages{};
   /// lateness per output of kHilOutputs (send time minus due time)
@@ -80,6 +84,8 @@ class HilReplay {
   PtyEmitter* pty() { return pty_.get(); }
   /// null when the recording sends nothing over UDP
   const UdpEmitter* udp() const { return udp_.get(); }
+  /// null when nothing goes to IIO devices
+  const IioEmitter* iio() const { return iio_.get(); }
   const HilReplayOptions& options() const { return options_; }
 
  private:
@@ -96,6 +102,7 @@ class HilReplay {
   Pacer pacer_;
   std::unique_ptr<UdpEmitter> udp_;
   std::unique_ptr<PtyEmitter> pty_;
+  std::unique_ptr<IioEmitter> iio_;
   std::atomic<bool> stop_{false};
   HilFaults faults_;
   /// log time of the first message sent: the faults' time origin [ns]

@@ -41,12 +41,14 @@ int run_replay(int argc, char** argv) {
       "  Velodyne data packets   -> UDP datagrams to HOST:PORT (default 127.0.0.1:2368)\n"
       "  Velodyne position       -> UDP datagrams to HOST:POSITION_PORT (default 8308)\n"
       "  A9 serial byte stream   -> a pseudo-terminal in raw mode, symlinked at --pty PATH\n"
+      "  D435i IMU (IIO records) -> IIO devices under --iio DIR, as the kernel lists them\n"
       "Messages are paced against an absolute schedule from their log times (lateness does not "
       "accumulate); how late each left is measured and reported. The live side's config names "
       "the same port (lidar.source: udp, lidar.data_port, lidar.address: the sender, e.g. "
-      "127.0.0.1) and imu.serial_device: PATH.",
+      "127.0.0.1) and imu.serial_device: PATH (and realsense_imu.sysfs_root: DIR/sys, "
+      "realsense_imu.dev_dir: DIR/dev).",
       "posectl replay"};
-  std::string path, udp_text = "127.0.0.1:2368,8308", pty_link;
+  std::string path, udp_text = "127.0.0.1:2368,8308", pty_link, iio_dir;
   double rate = 1.0, start_s = 0, duration_s = 0, wait_reader_s = 10;
   bool loop = false, no_udp = false, no_pty = false;
   app.add_option("FILE", path, "MCAP recording (posed --record, posectl record, posectl sim)")
@@ -58,6 +60,10 @@ int run_replay(int argc, char** argv) {
   app.add_option("--pty", pty_link,
                  "symlink to the pseudo-terminal carrying the A9 stream, e.g. /tmp/posed-a9 "
                  "(default: no link; the pty's own /dev/pts name is printed)");
+  app.add_option("--iio", iio_dir,
+                 "also re-emit the D435i's IMU (a recording's realsense_imu stream): DIR/sys/"
+                 "iio:deviceN (accel_3d, gyro_3d) as the kernel's HID sensor drivers list them, "
+                 "and DIR/dev/iio:deviceN as FIFOs carrying the records (default: not sent)");
   app.add_option("--rate", rate, "speed: 1 = recorded timing, 2 = twice as fast")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -92,6 +98,8 @@ int run_replay(int argc, char** argv) {
   }
   options.rate = rate;
   options.pty_link = pty_link;
+  options.iio_dir = iio_dir;
+  options.playlist.iio = !iio_dir.empty();
   options.playlist.path = path;
   options.playlist.start = Duration::from_seconds(start_s);
   options.playlist.duration = Duration::from_seconds(duration_s);
@@ -128,6 +136,8 @@ int run_replay(int argc, char** argv) {
                                                 : "not sent (switched off)";
     } else if (c.output == hil::HilOutput::kSerial) {
       where = "pty " + pty_name;
+    } else if (c.output == hil::HilOutput::kIio) {
+      where = "iio " + iio_dir;
     } else {
       where = "udp " + replay.udp()->destination(c.output == hil::HilOutput::kUdpData ? 0 : 1);
     }
@@ -250,6 +260,14 @@ int run_replay(int argc, char** argv) {
       std::printf("  pty reader          none opened %s within %.0f s; sent regardless\n",
                   pty_name.c_str(), wait_reader_s);
     }
+  }
+  if (replay.iio() != nullptr) {
+    std::printf(
+        "  iio                 %llu writes, %.3f MB to %s/dev; %llu B dropped (FIFO full); "
+        "lateness %s\n",
+        static_cast<unsigned long long>(s.iio.writes), megabytes(s.iio.bytes), iio_dir.c_str(),
+        static_cast<unsigned long long>(s.iio.bytes_dropped),
+        lateness_text(s.lateness[slot(hil::HilOutput::kIio)]).c_str());
   }
   hil::LatenessHistogram all;
   for (const auto& h : s.lateness) all.merge(h);

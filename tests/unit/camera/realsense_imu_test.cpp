@@ -358,6 +358,23 @@ TEST_F(FakeIio, MissingDeviceOrBadScanTypeFailsWithThePath) {
   EXPECT_NE(error.find("is 'als', not 'accel_3d'"), std::string::npos) << error;
 }
 
+TEST_F(FakeIio, DevicesThatAppearAfterStartAreOpenedByARead) {
+  // The camera is plugged in after posed started (or a HIL replay makes its devices later):
+  // the failed open at start is retried on every read.
+  const fs::path name = root_ / "sys" / "iio:device2" / "name";
+  write_file(name, "not_yet\n");
+  RealsenseImuSource source("imu", config());
+  std::string error;
+  EXPECT_FALSE(source.open(error));
+  RawChunk chunk;
+  EXPECT_EQ(source.read(chunk, Duration::from_ms(5)), ReadStatus::kDeviceLost);
+  write_file(name, "gyro_3d\n");
+  const ReadStatus s = source.read(chunk, Duration::from_ms(50));
+  EXPECT_TRUE(s == ReadStatus::kTimeout || s == ReadStatus::kData);
+  EXPECT_EQ(source.counters().reopened, 1u);
+  EXPECT_EQ(source.device(1).dev_node, (root_ / "dev" / "iio:device2").string());
+}
+
 TEST_F(FakeIio, HangUpIsDeviceLostAndTheDevicesAreReopened) {
   RealsenseImuSource source("imu", config());
   std::string error;
