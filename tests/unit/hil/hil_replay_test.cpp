@@ -123,7 +123,8 @@ TEST(HilReplay, EveryMessageReachesItsWireInOrderAndIsMeasured) {
   EXPECT_EQ(s.udp_position.datagrams, 2u);
   EXPECT_EQ(s.pty.writes, 20u);
   EXPECT_EQ(s.pty.bytes, serial.size());
-  const std::array<std::uint64_t, 3> expected = {100, 2, 20};  // kHilOutputs order
+  // kHilOutputs order: UDP data, UDP position, pty, IIO (the recording has no D435i IMU)
+  const std::array<std::uint64_t, kHilOutputs.size()> expected = {100, 2, 20, 0};
   for (std::size_t i = 0; i < kHilOutputs.size(); ++i) {
     EXPECT_EQ(s.messages[i], expected[i]) << to_string(kHilOutputs[i]);
     EXPECT_EQ(s.lateness[i].count(), expected[i]) << to_string(kHilOutputs[i]);
