@@ -60,7 +60,10 @@ ReplayRun replay(const TempDir& dir, const std::string& config, const std::strin
   auto reader = dds::Subscriber::create(c, topics, error);
   EXPECT_TRUE(reader) << error;
   PosedProcess p(
-      {posed(), "--config", config, "--replay", recording, "--max-speed", "--record", record_to},
+      // Discovery across processes can take longer than the default second on a loaded machine;
+      // a reader matched late misses the first poses, and the two runs would differ in count.
+      {posed(), "--config", config, "--replay", recording, "--max-speed", "--wait-subscribers",
+       "20", "--record", record_to},
       {}, dir);
   ReplayRun run;
   const auto code = p.wait_for_exit(60s);
