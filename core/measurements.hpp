@@ -21,6 +21,9 @@ struct ImuSample {
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();
   /// specific force (accelerometer reading; +9.81 on z at rest, level) in the IMU frame [m/s^2]
   Eigen::Vector3d specific_force_mps2 = Eigen::Vector3d::Zero();
+  /// measured by the rig's backup IMU (the D435i's) standing in for the primary (the A9): the
+  /// estimator weighs it with the backup's own noise densities
+  bool from_backup_imu = false;
 };
 
 /// One lidar return in the sensor frame (x forward, y left, z up).

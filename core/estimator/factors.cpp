@@ -23,16 +23,12 @@ void pose_jacobian(const Eigen::Matrix<double, M, 6>& J_tangent, const double* p
 
 }  // namespace
 
-ImuFactor::ImuFactor(const imu::Preintegration& pre, double gravity_mps2,
-                     const imu::ImuNoise& noise)
+ImuFactor::ImuFactor(const imu::Preintegration& pre, double gravity_mps2)
     : pre_(pre), g_(0, 0, -gravity_mps2) {
   Eigen::Matrix<double, 15, 15> cov = Eigen::Matrix<double, 15, 15>::Zero();
   cov.topLeftCorner<9, 9>() = pre.covariance();
-  const double dt = pre.dt_s();
-  cov.block<3, 3>(9, 9).diagonal().setConstant(noise.gyro_random_walk * noise.gyro_random_walk *
-                                               dt);
-  cov.block<3, 3>(12, 12).diagonal().setConstant(noise.accel_random_walk * noise.accel_random_walk *
-                                                 dt);
+  cov.block<3, 3>(9, 9).diagonal().setConstant(pre.gyro_bias_walk_variance());
+  cov.block<3, 3>(12, 12).diagonal().setConstant(pre.accel_bias_walk_variance());
   // A floor keeps the information finite for very short intervals and noise-free tests.
   cov += 1e-12 * Eigen::Matrix<double, 15, 15>::Identity();
   sqrt_info_ = Eigen::LLT<Eigen::Matrix<double, 15, 15>>(cov.inverse()).matrixL().transpose();

@@ -21,7 +21,8 @@ namespace posed::estimator {
 /// 15 residuals [rotation, velocity, position, gyro bias change, accel bias change].
 class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
  public:
-  ImuFactor(const imu::Preintegration& pre, double gravity_mps2, const imu::ImuNoise& noise);
+  /// Weighed by the preintegration's covariance and its biases' random walk.
+  ImuFactor(const imu::Preintegration& pre, double gravity_mps2);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 

@@ -17,7 +17,6 @@ namespace {
 SlidingWindowConfig window_config(const LioConfig& c) {
   SlidingWindowConfig w = c.window;
   w.gravity_mps2 = c.gravity_mps2;
-  w.noise = c.noise;
   w.T_imu_lidar = c.T_imu_lidar;
   return w;
 }
@@ -132,7 +131,9 @@ void LioEstimator::add_imu(const ImuSample& sample, std::vector<NavState>& state
     // Uncertainty grows from the anchor's with the IMU's white noise (random-walk model).
     Eigen::Matrix<double, 6, 6> cov = anchor_cov_;
     const double dt = (stamp - anchor_->stamp).seconds();
-    const double sa = config_.noise.accel_noise_density, sg = config_.noise.gyro_noise_density;
+    const imu::ImuNoise& n =
+        sample.from_backup_imu && config_.backup_noise ? *config_.backup_noise : config_.noise;
+    const double sa = n.accel_noise_density, sg = n.gyro_noise_density;
     cov.topLeftCorner<3, 3>().diagonal().array() += sa * sa * dt * dt * dt / 3.0;
     cov.bottomRightCorner<3, 3>().diagonal().array() += sg * sg * dt;
     NavState s = to_nav_state(
@@ -165,7 +166,9 @@ void LioEstimator::release_scans(std::vector<NavState>& states) {
 
 LioEstimator::Integrated LioEstimator::integrate(const imu::ImuState& from, HostTime t,
                                                  lidar::ScanMotion* motion) {
-  Integrated out{imu::Preintegration(config_.noise, from.bias, from.stamp), false};
+  Integrated out{imu::Preintegration(config_.noise, config_.backup_noise.value_or(config_.noise),
+                                     from.bias, from.stamp),
+                 false};
   imu_.samples_between(from.stamp, t, scratch_);
   if (scratch_.size() < 2) return out;
   if (motion != nullptr) motion->clear();

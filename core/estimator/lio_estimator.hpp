@@ -40,13 +40,15 @@ namespace posed::estimator {
 struct LioConfig {
   double gravity_mps2 = 9.805;
   imu::ImuNoise noise;
+  /// the backup IMU's (ImuSample::from_backup_imu); none: it is weighed as the primary
+  std::optional<imu::ImuNoise> backup_noise;
   imu::StaticAlignmentConfig alignment;
   /// without a still window by then, align while moving (MovingAlignment) [ns]
   Duration moving_alignment_after = Duration::from_s(3);
   /// the lidar in the IMU (base_link) frame
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
   lidar::LidarOdometryConfig lidar;
-  SlidingWindowConfig window;  ///< gravity, noise and T_imu_lidar are copied in from above
+  SlidingWindowConfig window;  ///< gravity and T_imu_lidar are copied in from above
   // Divergence limits: beyond any of them the estimate is not trusted.
   double max_speed_mps = 40.0;       ///< [m/s]
   double max_gyro_bias_radps = 0.3;  ///< [rad/s]

@@ -106,7 +106,9 @@ NavState OdometryPropagator::output(const ImuSample& sample) {
   // rotation variance added equally on every axis is the same in map-fixed and body axes.
   out.pose_covariance = anchor_->pose_covariance;
   const double dt = (propagated_.stamp - anchor_->stamp).seconds();
-  const double sa = config_.accel_noise_density, sg = config_.gyro_noise_density;
+  const bool backup = sample.from_backup_imu && config_.backup_accel_noise_density > 0;
+  const double sa = backup ? config_.backup_accel_noise_density : config_.accel_noise_density;
+  const double sg = backup ? config_.backup_gyro_noise_density : config_.gyro_noise_density;
   out.pose_covariance.topLeftCorner<3, 3>().diagonal().array() += sa * sa * dt * dt * dt / 3.0;
   out.pose_covariance.bottomRightCorner<3, 3>().diagonal().array() += sg * sg * dt;
   out.twist_covariance = anchor_->twist_covariance;

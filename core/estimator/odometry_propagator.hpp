@@ -25,6 +25,9 @@ struct OdometryPropagatorConfig {
   double gravity_mps2 = 9.805;
   double accel_noise_density = 0;  ///< for the covariance's growth [m/s^2/sqrt(Hz)]
   double gyro_noise_density = 0;   ///< [rad/s/sqrt(Hz)]
+  /// the backup IMU's, for its samples (ImuSample::from_backup_imu); 0: as the primary's
+  double backup_accel_noise_density = 0;  ///< [m/s^2/sqrt(Hz)]
+  double backup_gyro_noise_density = 0;   ///< [rad/s/sqrt(Hz)]
   /// a correction is spread linearly over this long; 0 applies it at once (snap) [s]
   double blend_s = 0.1;
   /// corrections beyond either of these are applied at once [m], [rad]

@@ -111,7 +111,7 @@ void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& p
   }
   if (previous) {
     add_factor(FactorKind::kImu,
-               std::make_unique<ImuFactor>(pre, config_.gravity_mps2, config_.noise),
+               std::make_unique<ImuFactor>(pre, config_.gravity_mps2),
                {{*previous, BlockRole::kPose},
                 {*previous, BlockRole::kSpeedBias},
                 {s.id, BlockRole::kPose},

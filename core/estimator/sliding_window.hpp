@@ -30,7 +30,6 @@ struct SlidingWindowConfig {
   int size = 10;           ///< states kept [1]
   int max_iterations = 8;  ///< Levenberg-Marquardt iterations per solve [1]
   double gravity_mps2 = 9.805;
-  imu::ImuNoise noise;
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
 };
 

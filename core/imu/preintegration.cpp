@@ -11,6 +11,7 @@ ImuSample interpolate_sample(const ImuSample& a, const ImuSample& b, HostTime t)
   const double s = span > 0 ? static_cast<double>((t - a.stamp).ns) / span : 0.0;
   ImuSample out = a;
   out.stamp = t;
+  out.from_backup_imu = b.from_backup_imu;  // [a, t] is part of [a, b], which b's IMU measured
   out.angular_velocity_radps =
       a.angular_velocity_radps + s * (b.angular_velocity_radps - a.angular_velocity_radps);
   out.specific_force_mps2 =
@@ -19,7 +20,11 @@ ImuSample interpolate_sample(const ImuSample& a, const ImuSample& b, HostTime t)
 }
 
 Preintegration::Preintegration(const ImuNoise& noise, const ImuBias& bias, HostTime stamp)
-    : noise_(noise), bias_(bias), start_(stamp), end_(stamp) {}
+    : Preintegration(noise, noise, bias, stamp) {}
+
+Preintegration::Preintegration(const ImuNoise& noise, const ImuNoise& backup_noise,
+                               const ImuBias& bias, HostTime stamp)
+    : noise_(noise), backup_noise_(backup_noise), bias_(bias), start_(stamp), end_(stamp) {}
 
 void Preintegration::add(const ImuSample& sample) {
   if (!have_last_) {
@@ -65,11 +70,13 @@ void Preintegration::integrate(const ImuSample& a, const ImuSample& b) {
   B.block<3, 3>(3, 3) = dR_ * dt;
   B.block<3, 3>(6, 3) = 0.5 * dR_ * dt * dt;
   Eigen::Matrix<double, 6, 6> Q = Eigen::Matrix<double, 6, 6>::Zero();
-  // Continuous white-noise densities become a per-sample variance sigma² / dt.
-  Q.block<3, 3>(0, 0).diagonal().setConstant(noise_.gyro_noise_density * noise_.gyro_noise_density /
-                                             dt);
-  Q.block<3, 3>(3, 3).diagonal().setConstant(noise_.accel_noise_density *
-                                             noise_.accel_noise_density / dt);
+  // Continuous white-noise densities become a per-sample variance sigma² / dt; the interval is
+  // the IMU's that measured its end sample.
+  const ImuNoise& n = b.from_backup_imu ? backup_noise_ : noise_;
+  Q.block<3, 3>(0, 0).diagonal().setConstant(n.gyro_noise_density * n.gyro_noise_density / dt);
+  Q.block<3, 3>(3, 3).diagonal().setConstant(n.accel_noise_density * n.accel_noise_density / dt);
+  if (b.from_backup_imu) backup_dt_s_ += dt;
+  if (b.from_backup_imu != a.from_backup_imu) ++imu_switches_;
   cov_ = A * cov_ * A.transpose() + B * Q * B.transpose();
 
   // Bias Jacobians of the midpoint step itself (as the deltas are integrated), so a bias update
@@ -91,6 +98,20 @@ void Preintegration::integrate(const ImuSample& a, const ImuSample& b) {
   // Keep dR a rotation: re-orthonormalise (drift over thousands of products is measurable).
   dR_ = Eigen::Quaterniond(dR_).normalized().toRotationMatrix();
   dt_s_ += dt;
+}
+
+double Preintegration::gyro_bias_walk_variance() const {
+  const double rw = noise_.gyro_random_walk, backup_rw = backup_noise_.gyro_random_walk;
+  const double offset = backup_noise_.gyro_bias_offset_radps;
+  return rw * rw * (dt_s_ - backup_dt_s_) + backup_rw * backup_rw * backup_dt_s_ +
+         imu_switches_ * offset * offset;
+}
+
+double Preintegration::accel_bias_walk_variance() const {
+  const double rw = noise_.accel_random_walk, backup_rw = backup_noise_.accel_random_walk;
+  const double offset = backup_noise_.accel_bias_offset_mps2;
+  return rw * rw * (dt_s_ - backup_dt_s_) + backup_rw * backup_rw * backup_dt_s_ +
+         imu_switches_ * offset * offset;
 }
 
 Eigen::Matrix3d Preintegration::corrected_delta_R(const Eigen::Vector3d& bg) const {

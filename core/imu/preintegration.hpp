@@ -26,6 +26,10 @@ struct ImuNoise {
   double accel_noise_density = 0;  ///< [m/s^2/sqrt(Hz)]
   double gyro_random_walk = 0;     ///< [rad/s^2/sqrt(Hz)]
   double accel_random_walk = 0;    ///< [m/s^3/sqrt(Hz)]
+  /// A backup IMU's: 1 sigma per axis of its bias less the primary's, the step the bias state
+  /// takes where one IMU's samples follow the other's (0 for the primary) [rad/s], [m/s^2]
+  double gyro_bias_offset_radps = 0;
+  double accel_bias_offset_mps2 = 0;
 };
 
 struct ImuBias {
@@ -46,6 +50,10 @@ class Preintegration {
  public:
   /// Starts empty at `stamp`, integrating with the biases `bias` (the linearisation point).
   Preintegration(const ImuNoise& noise, const ImuBias& bias, HostTime stamp);
+  /// The same, with an interval that ends on a sample `from_backup_imu` weighed by
+  /// `backup_noise` (the backup IMU's densities) instead of `noise`.
+  Preintegration(const ImuNoise& noise, const ImuNoise& backup_noise, const ImuBias& bias,
+                 HostTime stamp);
 
   /// Adds the interval from the previous sample to `sample` (the first call only sets the start
   /// sample). Samples must be in stamp order; an interval of zero or less is ignored.
@@ -67,6 +75,15 @@ class Preintegration {
   const Eigen::Vector3d& delta_p() const { return dp_; }
   /// covariance of [dphi, dv, dp] [rad², (m/s)², m²]
   const Eigen::Matrix<double, 9, 9>& covariance() const { return cov_; }
+  /// variance per axis of the gyroscope bias's random walk over the interval, each IMU's density
+  /// over the time it measured [(rad/s)²]
+  double gyro_bias_walk_variance() const;
+  /// the same for the accelerometer bias [(m/s²)²]
+  double accel_bias_walk_variance() const;
+  /// of dt_s(), the time the backup IMU measured [s]
+  double backup_dt_s() const { return backup_dt_s_; }
+  /// times one IMU's sample followed the other's [1]
+  int imu_switches() const { return imu_switches_; }
   const ImuBias& linearisation_bias() const { return bias_; }
 
   /// The deltas for other biases, to first order (bias_j - linearisation bias small).
@@ -93,12 +110,14 @@ class Preintegration {
  private:
   void integrate(const ImuSample& a, const ImuSample& b);
 
-  ImuNoise noise_;
+  ImuNoise noise_, backup_noise_;
   ImuBias bias_;
   HostTime start_, end_;
   bool have_last_ = false;
   ImuSample last_;
   double dt_s_ = 0;
+  double backup_dt_s_ = 0;
+  int imu_switches_ = 0;
   Eigen::Matrix3d dR_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d dv_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d dp_ = Eigen::Vector3d::Zero();

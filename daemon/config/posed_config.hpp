@@ -152,6 +152,14 @@ struct RealsenseImuSection {
   double accel_rate_hz = 250;      ///< [Hz]
   double gyro_rate_hz = 200;       ///< [Hz]
   double clock_latency_s = 0;      ///< minimum transport latency, device stamp to arrival [s]
+  // The estimator weighs its samples with these while it stands in for the A9.
+  double gyro_noise_density = 0;   ///< [rad/s/sqrt(Hz)]
+  double accel_noise_density = 0;  ///< [m/s^2/sqrt(Hz)]
+  double gyro_random_walk = 0;     ///< [rad/s^2/sqrt(Hz)]
+  double accel_random_walk = 0;    ///< [m/s^3/sqrt(Hz)]
+  /// 1 sigma per axis of its biases less the A9's: the step the bias state may take at a switch
+  double gyro_bias_offset_radps = 0;                ///< [rad/s]
+  double accel_bias_offset_mps2 = 0;                ///< [m/s^2]
   std::string sysfs_root = "/sys/bus/iio/devices";  ///< where the IIO devices are listed
   std::string dev_dir = "/dev";                     ///< where their character devices are
 };

@@ -23,6 +23,12 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
              .accel_noise_density = c.imu.accel_noise_density,
              .gyro_random_walk = c.imu.gyro_random_walk,
              .accel_random_walk = c.imu.accel_random_walk};
+  l.backup_noise = imu::ImuNoise{.gyro_noise_density = c.realsense_imu.gyro_noise_density,
+                                 .accel_noise_density = c.realsense_imu.accel_noise_density,
+                                 .gyro_random_walk = c.realsense_imu.gyro_random_walk,
+                                 .accel_random_walk = c.realsense_imu.accel_random_walk,
+                                 .gyro_bias_offset_radps = c.realsense_imu.gyro_bias_offset_radps,
+                                 .accel_bias_offset_mps2 = c.realsense_imu.accel_bias_offset_mps2};
   l.alignment = {.gravity_mps2 = c.imu.gravity_mps2,
                  .window = Duration::from_seconds(c.estimator.init_static_s),
                  .max_gyro_radps = c.estimator.init_max_gyro_radps,

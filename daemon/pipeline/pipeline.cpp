@@ -210,6 +210,10 @@ bool Pipeline::start(std::string& error) {
     odometry.gravity_mps2 = lio_settings.gravity_mps2;
     odometry.accel_noise_density = lio_settings.noise.accel_noise_density;
     odometry.gyro_noise_density = lio_settings.noise.gyro_noise_density;
+    if (lio_settings.backup_noise) {
+      odometry.backup_accel_noise_density = lio_settings.backup_noise->accel_noise_density;
+      odometry.backup_gyro_noise_density = lio_settings.backup_noise->gyro_noise_density;
+    }
     odometry.blend_s = config_.publish.odom_blend_s;
     if (in_stamp_order && !sources_.paced) {
       // Max speed: the fusion stage propagates in data order (deterministic; no one waits).

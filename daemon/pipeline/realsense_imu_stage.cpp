@@ -49,6 +49,7 @@ void RealsenseImuStage::push(const cam::RealsenseImuSample& s) {
   sample.device_stamp = clock_.status().last_device_stamp;
   sample.angular_velocity_radps = s.angular_velocity_radps;
   sample.specific_force_mps2 = s.specific_force_mps2;
+  sample.from_backup_imu = true;
   const PushResult r = queue_.push(ImuItem{sample, false, s.arrival, counters_.bad()});
   if (r != PushResult::kPushed) counters_.dropped.fetch_add(1, std::memory_order_relaxed);
   counters_.decoded.fetch_add(1, std::memory_order_relaxed);

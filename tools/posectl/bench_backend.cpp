@@ -114,7 +114,6 @@ int bench_backend() {
   estimator::SlidingWindowConfig wc;
   wc.size = 10;
   wc.gravity_mps2 = kGravity;
-  wc.noise = {2.3e-3, 3.8e-2, 1.4e-5, 1.1e-3};
   estimator::SlidingWindow with(wc), without(wc);
   Eigen::Matrix<double, 15, 1> sigma = Eigen::Matrix<double, 15, 1>::Constant(0.01);
   with.reset(state_at(0), sigma);

@@ -50,7 +50,7 @@ TEST(Factors, ImuFactorJacobiansMatchNumericDifferentiation) {
   lin.accel_mps2 = {0.05, 0.02, -0.04};
   imu::Preintegration pre({2e-3, 3e-2, 1e-5, 1e-3}, lin, HostTime::from_ns(0));
   for (int k = 0; k <= 40; ++k) pre.add(m.sample(1.0 + k / 200.0));
-  const ImuFactor factor(pre, m.gravity_mps2, {2e-3, 3e-2, 1e-5, 1e-3});
+  const ImuFactor factor(pre, m.gravity_mps2);
 
   imu::ImuState i = m.state(1.0), j = m.state(1.2);
   i.p_map_imu_m += Eigen::Vector3d(0.1, -0.05, 0.02);

@@ -29,11 +29,11 @@ Eigen::Isometry3d marg_pose_of(const imu::ImuState& s) {
 /// The last state of a window of `size` run over `states` steps of the same noisy data.
 imu::ImuState run_window(int size, int steps) {
   const test::AnalyticMotion m;
+  const imu::ImuNoise noise_density = {2e-3, 2e-2, 1e-5, 1e-3};
   SlidingWindowConfig c;
   c.size = size;
   c.max_iterations = 30;
   c.gravity_mps2 = m.gravity_mps2;
-  c.noise = {2e-3, 2e-2, 1e-5, 1e-3};
   SlidingWindow w(c);
   std::mt19937 rng(11);
   std::normal_distribution<double> n01(0, 1);
@@ -49,13 +49,14 @@ imu::ImuState run_window(int size, int steps) {
   for (int k = 1; k <= steps; ++k) {
     const double t = k * kMargStep;
     const imu::ImuState prev = w.latest();
-    imu::Preintegration pre(c.noise, prev.bias, prev.stamp);
+    imu::Preintegration pre(noise_density, prev.bias, prev.stamp);
     for (int i = 0; i <= static_cast<int>(std::lround(kMargStep * kMargImuHz)); ++i) {
       ImuSample s = m.sample(t - kMargStep + i / kMargImuHz);
       for (int a = 0; a < 3; ++a) {
         s.angular_velocity_radps[a] +=
-            c.noise.gyro_noise_density * std::sqrt(kMargImuHz) * n01(rng);
-        s.specific_force_mps2[a] += c.noise.accel_noise_density * std::sqrt(kMargImuHz) * n01(rng);
+            noise_density.gyro_noise_density * std::sqrt(kMargImuHz) * n01(rng);
+        s.specific_force_mps2[a] +=
+            noise_density.accel_noise_density * std::sqrt(kMargImuHz) * n01(rng);
       }
       pre.add(s);
     }

@@ -131,5 +131,55 @@ TEST(Preintegration, IntervalsEndExactlyAtAStampBetweenSamples) {
   EXPECT_LT((predicted.p_map_imu_m - m.p(0.007)).norm(), 1e-6);
 }
 
+TEST(Preintegration, TheBackupImusSamplesAreWeighedWithItsOwnNoise) {
+  const test::AnalyticMotion m;
+  const ImuNoise a9{2.3e-3, 3.8e-2, 1.4e-5, 1.1e-3};
+  const ImuNoise d435i{2.4e-4, 1.5e-3, 1.0e-5, 5.0e-4, 3e-3, 5e-2};
+  // The same samples: the A9's alone, the D435i's alone, and the D435i's over the second half.
+  Preintegration primary(a9, d435i, ImuBias{}, HostTime::from_ns(0));
+  Preintegration backup(a9, d435i, ImuBias{}, HostTime::from_ns(0));
+  Preintegration mixed(a9, d435i, ImuBias{}, HostTime::from_ns(0));
+  Preintegration only_d435i(d435i, ImuBias{}, HostTime::from_ns(0));
+  for (int k = 0; k <= 100; ++k) {
+    ImuSample s = m.sample(k / kRateHz);
+    primary.add(s);
+    s.from_backup_imu = true;
+    backup.add(s);
+    only_d435i.add(s);
+    s.from_backup_imu = k > 50;
+    mixed.add(s);
+  }
+  // The deltas do not depend on whose samples they are; the weights do.
+  EXPECT_EQ(primary.delta_p(), backup.delta_p());
+  EXPECT_EQ(backup.covariance(), only_d435i.covariance());
+  EXPECT_DOUBLE_EQ(backup.backup_dt_s(), 0.5);
+  EXPECT_DOUBLE_EQ(mixed.backup_dt_s(), 0.25);
+  EXPECT_DOUBLE_EQ(primary.backup_dt_s(), 0.0);
+  // Position variance: the A9's accelerometer is 25x noisier; half the interval on the D435i
+  // lies in between.
+  const double p_primary = primary.covariance()(6, 6), p_backup = backup.covariance()(6, 6),
+               p_mixed = mixed.covariance()(6, 6);
+  EXPECT_GT(p_primary, 100 * p_backup);
+  EXPECT_LT(p_mixed, p_primary);
+  EXPECT_GT(p_mixed, p_backup);
+  // Bias random walk: each IMU's density over the time it measured.
+  EXPECT_DOUBLE_EQ(primary.accel_bias_walk_variance(), 1.1e-3 * 1.1e-3 * 0.5);
+  EXPECT_DOUBLE_EQ(backup.accel_bias_walk_variance(), 5.0e-4 * 5.0e-4 * 0.5);
+  // and the step between the two IMUs' biases where one follows the other.
+  EXPECT_EQ(mixed.imu_switches(), 1);
+  EXPECT_EQ(backup.imu_switches(), 0);
+  EXPECT_NEAR(mixed.gyro_bias_walk_variance(),
+              1.4e-5 * 1.4e-5 * 0.25 + 1.0e-5 * 1.0e-5 * 0.25 + 3e-3 * 3e-3, 1e-18);
+  EXPECT_NEAR(mixed.accel_bias_walk_variance(),
+              1.1e-3 * 1.1e-3 * 0.25 + 5.0e-4 * 5.0e-4 * 0.25 + 5e-2 * 5e-2, 1e-15);
+  // An interval cut short at a stamp between samples belongs to the sample it ends on.
+  Preintegration cut(a9, d435i, ImuBias{}, HostTime::from_ns(0));
+  ImuSample first = m.sample(0.0), next = m.sample(0.005);
+  next.from_backup_imu = true;
+  cut.add(first);
+  cut.add_until(HostTime::from_ns(3'000'000), next);
+  EXPECT_DOUBLE_EQ(cut.backup_dt_s(), 0.003);
+}
+
 }  // namespace
 }  // namespace posed::imu

@@ -23,10 +23,10 @@ struct Result {
 Result run(const imu::ImuBias& true_bias, double duration_s, int window, double lidar_sigma_m,
            bool noise) {
   const test::AnalyticMotion m;
+  const imu::ImuNoise noise_density = {2.3e-3, 3.8e-2, 1.4e-5, 1.1e-3};
   SlidingWindowConfig c;
   c.size = window;
   c.gravity_mps2 = m.gravity_mps2;
-  c.noise = {2.3e-3, 3.8e-2, 1.4e-5, 1.1e-3};
   c.T_imu_lidar.translation() = Eigen::Vector3d(0.27, 0.0, 0.18);
   SlidingWindow w(c);
   std::mt19937 rng(5);
@@ -42,7 +42,7 @@ Result run(const imu::ImuBias& true_bias, double duration_s, int window, double 
   const double dt_scan = 0.1;
   for (double t = dt_scan; t <= duration_s + 1e-9; t += dt_scan) {
     const imu::ImuState prev = w.latest();
-    imu::Preintegration pre(c.noise, prev.bias, prev.stamp);
+    imu::Preintegration pre(noise_density, prev.bias, prev.stamp);
     const int steps = static_cast<int>(std::lround(dt_scan * kImuHz));
     for (int k = 0; k <= steps; ++k) {
       ImuSample s = m.sample(t - dt_scan + k / kImuHz);
@@ -50,8 +50,10 @@ Result run(const imu::ImuBias& true_bias, double duration_s, int window, double 
       s.specific_force_mps2 += true_bias.accel_mps2;
       if (noise) {
         for (int a = 0; a < 3; ++a) {
-          s.angular_velocity_radps[a] += c.noise.gyro_noise_density * std::sqrt(kImuHz) * n01(rng);
-          s.specific_force_mps2[a] += c.noise.accel_noise_density * std::sqrt(kImuHz) * n01(rng);
+          s.angular_velocity_radps[a] +=
+              noise_density.gyro_noise_density * std::sqrt(kImuHz) * n01(rng);
+          s.specific_force_mps2[a] +=
+              noise_density.accel_noise_density * std::sqrt(kImuHz) * n01(rng);
         }
       }
       pre.add(s);
