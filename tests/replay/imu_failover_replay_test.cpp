@@ -30,12 +30,14 @@ struct Replay {
   std::map<std::int64_t, rec::ros2::StampedPose> odom, poses;
 };
 
-Replay replay(TempDir& dir, const std::string& recording, const std::string& name, bool failover) {
+/// `realsense_imu` holds more of that section's keys, each line indented by two spaces.
+Replay replay(TempDir& dir, const std::string& recording, const std::string& name, bool failover,
+              const std::string& realsense_imu = "") {
   const std::string config = dir.write(
       name + ".yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
                           "\n  cyclonedds_config: " + source_dir() +
                           "/config/cyclonedds-loopback.xml\nrealsense_imu:\n  failover: " +
-                          (failover ? "true" : "false") + "\n");
+                          (failover ? "true" : "false") + "\n" + realsense_imu);
   const std::string out = dir.file(name + ".mcap");
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--wait-subscribers", "0", "--record", out},
@@ -43,6 +45,25 @@ Replay replay(TempDir& dir, const std::string& recording, const std::string& nam
   EXPECT_EQ(posed.wait_for_exit(120s), 0) << posed.err();
   return {posed.err() + posed.out(), recorded_poses(out, "/posed/odom", true),
           recorded_poses(out, "/posed/pose", false)};
+}
+
+using Poses = std::map<std::int64_t, rec::ros2::StampedPose>;
+
+/// ATE RMSE of `poses` against `truth` after the best rigid alignment (the estimate's map is not
+/// the simulator's) [m].
+double ate_m(const Poses& poses, const Poses& truth) {
+  std::vector<Eigen::Vector3d> est, gt;
+  for (const auto& [stamp, p] : poses) {
+    const auto it = truth.lower_bound(stamp - 5'000'000);
+    if (it == truth.end() || std::llabs(it->first - stamp) > 5'000'000) continue;
+    est.emplace_back(p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]);
+    gt.emplace_back(it->second.p_xyz_m[0], it->second.p_xyz_m[1], it->second.p_xyz_m[2]);
+  }
+  if (est.size() < 3) return 1e9;
+  const eval::Sim3 T = eval::umeyama(est, gt, false);
+  double sq = 0;
+  for (std::size_t i = 0; i < est.size(); ++i) sq += (T.apply(est[i]) - gt[i]).squaredNorm();
+  return std::sqrt(sq / static_cast<double>(est.size()));
 }
 
 TEST(ImuFailoverReplay, TheD435iImuCarriesTheEstimateThroughAnA9GapAndHandsBack) {
@@ -63,21 +84,7 @@ TEST(ImuFailoverReplay, TheD435iImuCarriesTheEstimateThroughAnA9GapAndHandsBack)
   const auto seconds = [&](std::int64_t stamp) {
     return static_cast<double>(stamp - start_ns) * 1e-9;
   };
-  // ATE RMSE after the best rigid alignment (the estimate's map is not the simulator's) [m].
-  const auto ate = [&](const std::map<std::int64_t, rec::ros2::StampedPose>& poses) {
-    std::vector<Eigen::Vector3d> est, gt;
-    for (const auto& [stamp, p] : poses) {
-      const auto it = truth.lower_bound(stamp - 5'000'000);
-      if (it == truth.end() || std::llabs(it->first - stamp) > 5'000'000) continue;
-      est.emplace_back(p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]);
-      gt.emplace_back(it->second.p_xyz_m[0], it->second.p_xyz_m[1], it->second.p_xyz_m[2]);
-    }
-    if (est.size() < 3) return 1e9;
-    const eval::Sim3 T = eval::umeyama(est, gt, false);
-    double sq = 0;
-    for (std::size_t i = 0; i < est.size(); ++i) sq += (T.apply(est[i]) - gt[i]).squaredNorm();
-    return std::sqrt(sq / static_cast<double>(est.size()));
-  };
+  const auto ate = [&](const Poses& poses) { return ate_m(poses, truth); };
 
   const Replay on = replay(dir, recording, "failover", true);
   EXPECT_NE(on.log.find("the estimate runs on the D435i's IMU"), std::string::npos) << on.log;
@@ -116,6 +123,42 @@ TEST(ImuFailoverReplay, TheD435iImuCarriesTheEstimateThroughAnA9GapAndHandsBack)
   EXPECT_LT(during_off, 10u);
   RecordProperty("ate_without_failover_m", std::to_string(ate(off.poses)));
   std::printf("ATE with the failover %.4f m, without %.4f m\n", ate_on, ate(off.poses));
+}
+
+// With the lidar out too, the D435i's samples alone carry the odometry: weighed with its own
+// noise, and with the bias state free to step to the D435i's bias where its samples begin
+// (realsense_imu.*_bias_offset), it drifts less than weighed as the A9 with the A9's bias.
+TEST(ImuFailoverReplay, TheD435isOwnNoiseAndBiasCarryTheOdometryWhenTheLidarIsOutToo) {
+  TempDir dir;
+  const std::string recording = dir.file("street.mcap");
+  {
+    PosedProcess sim(
+        {simulator(), "sim", "--scenario", "street_night", "--duration", "12", "--seed", "9",
+         "--no-cameras", "--realsense-imu", "--config", source_dir() + "/config/posed.yaml", "-o",
+         recording, "--fault", "imu_gap@5+4", "--fault", "lidar_outage@6+2"},
+        {}, dir);
+    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+  }
+  const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
+  ASSERT_FALSE(truth.empty());
+  // The shipped weights against the A9's densities and no bias step (before stop 34).
+  const Replay own = replay(dir, recording, "own", true);
+  const Replay as_a9 = replay(dir, recording, "as_a9", true,
+                              "  gyro_noise_density: 2.3417543020438883e-03\n"
+                              "  gyro_random_walk: 1.4428407712885209e-05\n"
+                              "  accel_noise_density: 3.7686306102624571e-02\n"
+                              "  accel_random_walk: 1.1416642385952368e-03\n"
+                              "  gyro_bias_offset_radps: 0\n"
+                              "  accel_bias_offset_mps2: 0\n");
+  ASSERT_NE(own.log.find("imu failover        1 time(s)"), std::string::npos) << own.log;
+  const double odom_own = ate_m(own.odom, truth), odom_as_a9 = ate_m(as_a9.odom, truth);
+  std::printf(
+      "odom ATE through the A9 gap with the lidar out: own noise %.4f m, as the A9 %.4f m\n",
+      odom_own, odom_as_a9);
+  RecordProperty("odom_ate_own_noise_m", std::to_string(odom_own));
+  RecordProperty("odom_ate_as_a9_m", std::to_string(odom_as_a9));
+  EXPECT_LT(odom_own, odom_as_a9);
+  EXPECT_LT(ate_m(own.poses, truth), 0.10);
 }
 
 }  // namespace imu_failover_replay_test
