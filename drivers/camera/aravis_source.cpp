@@ -9,6 +9,11 @@
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
 
+#if defined(__SANITIZE_THREAD__)
+extern "C" void __tsan_acquire(void* addr);
+extern "C" void __tsan_release(void* addr);
+#endif
+
 namespace posed::drivers::camera {
 
 struct AravisSource::Impl {
@@ -27,6 +32,33 @@ std::string take_error(GError*& e) {
   std::string m = e->message != nullptr ? e->message : "unknown error";
   g_clear_error(&e);
   return m;
+}
+
+// A buffer passes between Aravis's stream thread and read() through GLib's queue, whose futexes
+// ThreadSanitizer cannot see (GLib is not built with it): without telling it, the thread that
+// filled a frame and the one that decodes it look like a race. The hand-overs are announced here,
+// on the buffer's address, in both directions; outside TSan builds these do nothing.
+void announce_handed_over(ArvBuffer* buffer) {
+#if defined(__SANITIZE_THREAD__)
+  __tsan_release(buffer);
+#else
+  (void)buffer;
+#endif
+}
+
+void announce_taken_over(ArvBuffer* buffer) {
+#if defined(__SANITIZE_THREAD__)
+  __tsan_acquire(buffer);
+#else
+  (void)buffer;
+#endif
+}
+
+/// Aravis's stream thread: it takes a buffer read() gave back, and gives it filled.
+void on_stream_event(void* /*user*/, ArvStreamCallbackType type, ArvBuffer* buffer) {
+  if (buffer == nullptr) return;
+  if (type == ARV_STREAM_CALLBACK_TYPE_START_BUFFER) announce_taken_over(buffer);
+  if (type == ARV_STREAM_CALLBACK_TYPE_BUFFER_DONE) announce_handed_over(buffer);
 }
 
 void on_control_lost(ArvDevice* /*device*/, gpointer user) {
@@ -184,7 +216,7 @@ bool AravisSource::open(std::string& error) {
   const guint payload = arv_camera_get_payload(cam, &e);
   if (e != nullptr) return fail("PayloadSize");
 
-  impl_->stream = arv_camera_create_stream(cam, nullptr, nullptr, &e);
+  impl_->stream = arv_camera_create_stream(cam, on_stream_event, nullptr, &e);
   if (impl_->stream == nullptr) return fail("creating the stream");
   if (ARV_IS_GV_STREAM(impl_->stream)) {
     g_object_set(impl_->stream, "packet-resend",
@@ -193,7 +225,9 @@ bool AravisSource::open(std::string& error) {
                  nullptr);
   }
   for (std::uint32_t i = 0; i < config_.buffer_count; ++i) {
-    arv_stream_push_buffer(impl_->stream, arv_buffer_new_allocate(payload));
+    ArvBuffer* buffer = arv_buffer_new_allocate(payload);
+    announce_handed_over(buffer);
+    arv_stream_push_buffer(impl_->stream, buffer);
   }
   impl_->control_lost.store(false);
   g_signal_connect(device, "control-lost", G_CALLBACK(on_control_lost), impl_.get());
@@ -233,12 +267,14 @@ ReadStatus AravisSource::read(RawChunk& chunk, Duration timeout) {
     return ReadStatus::kDeviceLost;
   }
   if (impl_->held != nullptr) {
+    announce_handed_over(impl_->held);
     arv_stream_push_buffer(impl_->stream, impl_->held);
     impl_->held = nullptr;
   }
   ArvBuffer* buffer = arv_stream_timeout_pop_buffer(
       impl_->stream, static_cast<guint64>(std::max<std::int64_t>(0, timeout.ns / 1000)));
   if (buffer == nullptr) return ReadStatus::kTimeout;
+  announce_taken_over(buffer);
   impl_->held = buffer;
   frame_ = {};
   frame_.host_receive = host_now();
