@@ -1,0 +1,148 @@
+#pragma once
+// The mapping layer's keyframe graph (DESIGN.md, Data flow: mapping → tf map→odom). Odometry
+// poses and their deskewed scans go in; every metre (or turn) one becomes a keyframe: its pose,
+// a thinned copy of its cloud and a Scan Context. At keyframes it looks for a loop: a keyframe
+// older than min_separation_s near the current estimate (by distance), or, when drift is too
+// large for that, one whose Scan Context matches (by descriptor; such a loop is accepted only
+// when the next attempt confirms the same correction, because a repetitive place matches
+// descriptors everywhere). Each candidate is verified by registration (registration.hpp) onto a
+// submap around it; a verified one becomes a loop edge and the graph is optimised. What comes out
+// is map → odom: the correction that moves the odometry frame onto the optimised map, so odometry
+// itself stays continuous (REP-105).
+//
+// Pure and single-threaded like the rest of core/: the daemon runs it on a stage of its own,
+// off the real-time path (a registration costs tens of milliseconds, an optimisation more).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/mapping/pose_graph.hpp"
+#include "core/mapping/registration.hpp"
+#include "core/mapping/scan_context.hpp"
+#include "core/time.hpp"
+
+namespace posed::mapping {
+
+struct LoopClosureConfig {
+  double keyframe_distance_m = 1.0;    ///< a new keyframe after moving this far [m]
+  double keyframe_angle_rad = 0.35;    ///< or turning this much [rad]
+  double keyframe_voxel_m = 0.3;       ///< a keyframe's cloud is kept at this resolution [m]
+  double keyframe_max_range_m = 60.0;  ///< points farther are not kept [m]
+  /// loops are looked for at every n-th keyframe: registration is the expensive part [1]
+  int attempt_every_keyframes = 2;
+  /// a candidate must be at least this much older than the query: a loop, not a neighbour [s]
+  double min_separation_s = 30.0;
+  double search_radius_m = 8.0;  ///< distance candidates: within this of the estimate [m]
+  int submap_keyframes = 8;      ///< keyframes either side of the candidate in its submap [1]
+  ScanContextConfig scan_context;
+  double scan_context_max_distance = 0.25;  ///< descriptor candidates: at most this distance
+  int ring_key_candidates = 8;              ///< nearest ring keys compared in full [1]
+  /// a descriptor loop whose correction moves the query more than search_radius_m waits for the
+  /// next attempt to agree within these [m], [rad]
+  double confirm_translation_m = 1.0;
+  double confirm_rotation_rad = 0.05;
+  RegistrationConfig registration;
+  // Edge weights. Odometry: sigma = base + per-metre x distance between the keyframes.
+  double odometry_sigma_translation_m = 0.01;
+  double odometry_sigma_translation_per_m = 0.01;
+  double odometry_sigma_rotation_rad = 0.001;
+  double odometry_sigma_rotation_per_m = 0.001;
+  double loop_sigma_translation_m = 0.05;
+  double loop_sigma_rotation_rad = 0.01;
+  /// Cauchy scale on loop edges [sigma]; 0: none. Off by default: a true loop after long drift
+  /// starts hundreds of sigmas off and a robust loss would discard it as an outlier; the
+  /// registration's tests and the descriptor confirmation are what keep wrong loops out.
+  double loop_robust_sigmas = 0.0;
+};
+
+/// One accepted loop, for the status, the summary and the tests.
+struct LoopRecord {
+  std::size_t query = 0;      ///< keyframe index [1]
+  std::size_t candidate = 0;  ///< keyframe index [1]
+  HostTime stamp;             ///< the query keyframe's stamp
+  bool by_descriptor = false;
+  double rms_m = 0;         ///< registration inlier RMS [m]
+  double overlap = 0;       ///< registration overlap [0..1]
+  double constraint = 0;    ///< weakest direction's information share [0..1]
+  double correction_m = 0;  ///< how far the loop moved the query from the graph's estimate [m]
+};
+
+struct LoopClosureFigures {
+  std::uint64_t keyframes = 0;
+  std::uint64_t attempts = 0;               ///< keyframes a loop was looked for at [1]
+  std::uint64_t distance_candidates = 0;    ///< [1]
+  std::uint64_t descriptor_candidates = 0;  ///< [1]
+  std::uint64_t loops = 0;                  ///< accepted [1]
+  std::uint64_t unconfirmed = 0;            ///< descriptor loops the next attempt contradicted
+  std::array<std::uint64_t, 6> rejected{};  ///< by RegistrationVerdict [1]
+  std::uint64_t optimisations = 0;          ///< [1]
+  double last_optimisation_s = 0;           ///< [s]
+  double registration_time_s = 0;           ///< summed [s]
+  std::size_t stored_points = 0;            ///< keyframe cloud points held [1]
+};
+
+class LoopCloser {
+ public:
+  explicit LoopCloser(LoopClosureConfig config);
+
+  /// One odometry pose and the scan at it (`points_base`: the deskewed scan in base_link at
+  /// `stamp`). Returns true when it became a keyframe. Poses must come in stamp order.
+  bool add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
+           std::span<const Eigen::Vector3f> points_base);
+
+  /// The correction from the odometry frame onto the optimised map.
+  const Eigen::Isometry3d& T_map_odom() const { return T_map_odom_; }
+  /// Keyframe i's optimised pose (base_link in map).
+  Eigen::Isometry3d T_map_keyframe(std::size_t i) const { return graph_.node(i); }
+  std::size_t keyframe_count() const { return keyframes_.size(); }
+  HostTime keyframe_stamp(std::size_t i) const { return keyframes_.at(i).stamp; }
+  std::span<const Eigen::Vector3f> keyframe_points(std::size_t i) const {
+    return keyframes_.at(i).points_base;
+  }
+
+  const LoopClosureFigures& figures() const { return figures_; }
+  const std::vector<LoopRecord>& loops() const { return loops_; }
+  const PoseGraph& graph() const { return graph_; }
+
+ private:
+  struct Keyframe {
+    HostTime stamp;
+    Eigen::Isometry3d T_odom_base;
+    Eigen::Matrix3d R_level_base;  ///< removes roll and pitch: the Scan Context's frame
+    std::vector<Eigen::Vector3f> points_base;
+    ScanContext context;
+  };
+  struct Candidate {
+    std::size_t index = 0;
+    bool by_descriptor = false;
+    Eigen::Isometry3d T_candidate_query_guess = Eigen::Isometry3d::Identity();
+  };
+  struct Pending {
+    std::size_t query = 0;
+    Eigen::Isometry3d T_map_query;  ///< where the unconfirmed loop puts the query
+    PoseGraphEdge edge;
+    LoopRecord record;
+  };
+
+  void try_loop(std::size_t query);
+  std::optional<Candidate> distance_candidate(std::size_t query) const;
+  std::optional<Candidate> descriptor_candidate(std::size_t query) const;
+  std::vector<Eigen::Vector3f> submap(std::size_t centre, std::size_t newest_allowed) const;
+  void accept(const PoseGraphEdge& edge, const LoopRecord& record);
+  void update_correction();
+
+  LoopClosureConfig config_;
+  std::vector<Keyframe> keyframes_;
+  PoseGraph graph_;
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
+  std::optional<Pending> pending_;
+  LoopClosureFigures figures_;
+  std::vector<LoopRecord> loops_;
+};
+
+}  // namespace posed::mapping

@@ -1,0 +1,132 @@
+#include "core/mapping/loop_closer.hpp"
+
+#include <gtest/gtest.h>
+
+#include "core/lidar/scan_motion.hpp"
+#include "tests/unit/lidar/sim_fixture.hpp"
+#include "tests/unit/mapping/synthetic_scene.hpp"
+
+namespace posed::mapping {
+namespace {
+
+/// Odometry that drifts as lidar odometry does where geometry is poor: a heading error growing
+/// by `yaw_radps` and a position error by `drift_mps` along the start's x, from the first pose.
+struct DriftingOdometry {
+  double yaw_radps = 0.0;
+  double drift_mps = 0.0;
+  Eigen::Isometry3d T_odom_base(const sim::LidarImuRun& run, HostTime t) const {
+    const double s = static_cast<double>(t.ns - run.scans.front().end.ns) * 1e-9;
+    const Eigen::Isometry3d T_map_start = run.T_map_base(run.scans.front().end);
+    // The drift acts about the start pose, so the odometry starts where the truth does.
+    const Eigen::Isometry3d D =
+        T_map_start * test::pose(drift_mps * s, 0, 0, yaw_radps * s) * T_map_start.inverse();
+    return D * run.T_map_base(t);
+  }
+};
+
+struct Replayed {
+  double odometry_error_m = 0;            ///< of the last pose [m]
+  double corrected_error_m = 0;           ///< with the loop closer's map -> odom [m]
+  double worst_corrected_keyframe_m = 0;  ///< of the keyframes after optimisation [m]
+};
+
+/// Feeds every scan of `run`, deskewed with the true motion and put in base_link, to `closer`
+/// with `odometry`'s poses.
+Replayed replay(const sim::LidarImuRun& run, const DriftingOdometry& odometry, LoopCloser& closer) {
+  std::vector<lidar::ScanPoint> deskewed;
+  std::vector<Eigen::Vector3f> points_base;
+  const Eigen::Isometry3f T_base_lidar = run.rig.T_imu_lidar.cast<float>();
+  for (const sim::DecodedScan& scan : run.scans) {
+    lidar::deskew(scan.points, scan.start, test::true_motion(run, scan), 1800, 0.5f, 100.f,
+                  deskewed);
+    points_base.clear();
+    for (const lidar::ScanPoint& p : deskewed) {
+      points_base.push_back(T_base_lidar * p.p);
+    }
+    closer.add(scan.end, odometry.T_odom_base(run, scan.end), points_base);
+  }
+  Replayed out;
+  const HostTime end = run.scans.back().end;
+  const Eigen::Vector3d truth = run.T_map_base(end).translation();
+  // The graph's map frame is the first keyframe's odometry frame, which the drift leaves
+  // where the truth's map frame is.
+  out.odometry_error_m = (odometry.T_odom_base(run, end).translation() - truth).norm();
+  out.corrected_error_m =
+      ((closer.T_map_odom() * odometry.T_odom_base(run, end)).translation() - truth).norm();
+  for (std::size_t i = 0; i < closer.keyframe_count(); ++i) {
+    const Eigen::Vector3d kf_truth = run.T_map_base(closer.keyframe_stamp(i)).translation();
+    out.worst_corrected_keyframe_m = std::max(
+        out.worst_corrected_keyframe_m, (closer.T_map_keyframe(i).translation() - kf_truth).norm());
+  }
+  return out;
+}
+
+TEST(LoopCloser, ClosesTheRoomsLoopAndTakesOutTheDrift) {
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  LoopClosureConfig config;
+  config.min_separation_s = 15.0;
+  LoopCloser closer(config);
+  const DriftingOdometry odometry{.yaw_radps = 0.004, .drift_mps = 0.02};
+  const Replayed r = replay(run, odometry, closer);
+  const LoopClosureFigures& f = closer.figures();
+  EXPECT_GT(f.keyframes, 20u);
+  ASSERT_GT(f.loops, 0u) << "attempts " << f.attempts << " candidates " << f.distance_candidates
+                         << "/" << f.descriptor_candidates << " rejected diverged " << f.rejected[2]
+                         << " not_close " << f.rejected[3] << " low_overlap " << f.rejected[4]
+                         << " degenerate " << f.rejected[5];
+  for (const LoopRecord& loop : closer.loops()) {
+    EXPECT_LT(loop.rms_m, config.registration.max_rms_m);
+    EXPECT_GE(loop.overlap, config.registration.min_overlap);
+  }
+  EXPECT_GT(r.odometry_error_m, 0.4);
+  EXPECT_LT(r.corrected_error_m, 0.1) << "odometry error " << r.odometry_error_m;
+  EXPECT_LT(r.corrected_error_m, 0.25 * r.odometry_error_m);
+}
+
+TEST(LoopCloser, FindsLoopsByDescriptorAloneWhenTheEstimateIsNoGuide) {
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  LoopClosureConfig config;
+  config.min_separation_s = 15.0;
+  // No candidate is ever near enough the estimate: only Scan Context can find the revisits, and
+  // each of its loops must be confirmed by the next attempt before it is accepted.
+  config.search_radius_m = 0.0;
+  LoopCloser closer(config);
+  const DriftingOdometry odometry{.yaw_radps = 0.004, .drift_mps = 0.02};
+  const Replayed r = replay(run, odometry, closer);
+  ASSERT_FALSE(closer.loops().empty());
+  for (const LoopRecord& loop : closer.loops()) {
+    EXPECT_TRUE(loop.by_descriptor);
+  }
+  EXPECT_GT(r.odometry_error_m, 0.4);
+  EXPECT_LT(r.corrected_error_m, 0.15) << "odometry error " << r.odometry_error_m;
+  EXPECT_LT(r.corrected_error_m, 0.3 * r.odometry_error_m);
+}
+
+TEST(LoopCloser, WithoutLoopsTheCorrectionStaysIdentity) {
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  LoopClosureConfig config;
+  config.min_separation_s = 1000.0;  // nothing is ever old enough to be a loop
+  LoopCloser closer(config);
+  const Replayed r = replay(run, DriftingOdometry{.yaw_radps = 0.002, .drift_mps = 0.01}, closer);
+  EXPECT_EQ(closer.figures().loops, 0u);
+  EXPECT_TRUE(closer.T_map_odom().isApprox(Eigen::Isometry3d::Identity(), 1e-9));
+  EXPECT_NEAR(r.corrected_error_m, r.odometry_error_m, 1e-9);
+}
+
+TEST(LoopCloser, AcceptsNoLoopInAPlainCorridorWhereOdometrySlidAlongIt) {
+  // Odometry that slid along the corridor: every revisit's registration could only agree with
+  // the wrong estimate. None may be accepted.
+  const sim::LidarImuRun& run = test::simulated("corridor", 60.0);
+  LoopClosureConfig config;
+  config.min_separation_s = 20.0;
+  LoopCloser closer(config);
+  replay(run, DriftingOdometry{.yaw_radps = 0.0, .drift_mps = 0.05}, closer);
+  const LoopClosureFigures& f = closer.figures();
+  EXPECT_GT(f.distance_candidates + f.descriptor_candidates, 5u);
+  EXPECT_EQ(f.loops, 0u) << "first loop: keyframe " << closer.loops().front().query << " -> "
+                         << closer.loops().front().candidate << " constraint "
+                         << closer.loops().front().constraint;
+}
+
+}  // namespace
+}  // namespace posed::mapping
