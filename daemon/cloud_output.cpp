@@ -62,7 +62,8 @@ void CloudOutput::after_scan(const FusionCore& core) {
   if (map_on_ && scan.stamp >= next_map_stamp_) {
     next_map_stamp_ = scan.stamp + Duration::from_seconds(1.0 / config_.publish.map_rate_hz);
     core.local_map(map_points_);
-    map_cloud(map_points_, stamp, config_.dds.map_frame, map_.building);
+    // The estimator's local map is in its own frame: odom (loops move map -> odom only).
+    map_cloud(map_points_, stamp, config_.dds.odom_frame, map_.building);
     post(map_);
   }
 }

@@ -38,13 +38,14 @@ void PoseSinks::publish_static_transforms(WallTime stamp) {
   }
 }
 
-void PoseSinks::ros_outputs(const NavState& s, const dds::PoseMessage& pose) {
+void PoseSinks::ros_outputs(const NavState& s, const Eigen::Isometry3d& T_map_odom,
+                            const dds::PoseMessage& pose) {
   if (!publisher_) return;
   if (config_.publish.tf && (config_.publish.tf_max_rate_hz <= 0 || s.stamp >= next_tf_stamp_)) {
     if (config_.publish.tf_max_rate_hz > 0) {
       next_tf_stamp_ = s.stamp + Duration::from_seconds(1.0 / config_.publish.tf_max_rate_hz);
     }
-    if (!publisher_->publish_tf(tf_tree(config_.dds, s, pose.stamp))) {
+    if (!publisher_->publish_tf(tf_tree(config_.dds, s, T_map_odom, pose.stamp))) {
       tally_.failed.fetch_add(1, std::memory_order_relaxed);
     }
   }
@@ -109,14 +110,14 @@ void PoseSinks::odom(const NavState& s) {
     // After the write: the recording must never delay the odometry.
     const Eigen::Quaterniond& q = s.q_map_base;
     const Eigen::Vector3d v_base = s.q_map_base.conjugate() * s.v_map_mps;
-    recorder_->write_odometry("/posed/odom", stamp, config_.dds.map_frame, config_.dds.base_frame,
+    recorder_->write_odometry("/posed/odom", stamp, config_.dds.odom_frame, config_.dds.base_frame,
                               {s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z()},
                               {q.x(), q.y(), q.z(), q.w()}, {v_base.x(), v_base.y(), v_base.z()},
                               {s.w_base_radps.x(), s.w_base_radps.y(), s.w_base_radps.z()});
   }
 }
 
-void PoseSinks::state(const NavState& s) {
+void PoseSinks::state(const NavState& s, const Eigen::Isometry3d& T_map_odom) {
   const WallTime stamp = to_wall_(s.stamp);
   newest_state_stamp_ = s.stamp;
   if (static_pending_) publish_static_transforms(stamp);
@@ -129,10 +130,11 @@ void PoseSinks::state(const NavState& s) {
       s.optimised || (!tally_.have_optimised && s.stamp >= tally_.next_pose_stamp);
   if (pose_now) {
     tally_.next_pose_stamp = s.stamp + pose_period_;
+    // The state is in the odometry frame (the estimator's); the pose goes out in map.
     dds::PoseMessage pose;
     pose.stamp = stamp;
-    pose.p_map_base_m = s.p_map_base_m;
-    pose.q_map_base = s.q_map_base;
+    pose.p_map_base_m = T_map_odom * s.p_map_base_m;
+    pose.q_map_base = Eigen::Quaterniond(T_map_odom.rotation()) * s.q_map_base;
     if (!publisher_) {
       // offline run: nothing to publish
     } else if (publisher_->publish_pose(pose)) {
@@ -141,11 +143,11 @@ void PoseSinks::state(const NavState& s) {
     } else {
       tally_.failed.fetch_add(1, std::memory_order_relaxed);
     }
-    ros_outputs(s, pose);
+    ros_outputs(s, T_map_odom, pose);
     if (recorder_) {
-      const Eigen::Quaterniond& q = s.q_map_base;
-      recorder_->write_pose("/posed/pose", stamp, config_.dds.map_frame,
-                            {s.p_map_base_m.x(), s.p_map_base_m.y(), s.p_map_base_m.z()},
+      const Eigen::Quaterniond& q = pose.q_map_base;
+      const Eigen::Vector3d& p = pose.p_map_base_m;
+      recorder_->write_pose("/posed/pose", stamp, config_.dds.map_frame, {p.x(), p.y(), p.z()},
                             {q.x(), q.y(), q.z(), q.w()});
     }
   }

@@ -101,10 +101,12 @@ class PoseSinks {
   /// IMU-rate odometry: rt/posed/odom (every publish.odom_decimation-th) and /posed/odom. From
   /// one thread at a time.
   void odom(const NavState& s);
-  /// A state from the publisher stage: optimised ones on rt/posed/pose and /posed/pose; the
-  /// back end's propagation (when odometry is not decoupled) to odom(), and decimated onto pose
-  /// for an estimator without optimised states.
-  void state(const NavState& s);
+  /// A state from the publisher stage: optimised ones on rt/posed/pose and /posed/pose, moved
+  /// into the map frame by `T_map_odom` (the mapping stage's correction; rt/tf carries it as
+  /// map -> odom); the back end's propagation (when odometry is not decoupled) to odom(), and
+  /// decimated onto pose for an estimator without optimised states.
+  void state(const NavState& s,
+             const Eigen::Isometry3d& T_map_odom = Eigen::Isometry3d::Identity());
   /// rt/posed/status and rt/diagnostics, and the line for systemd's STATUS=.
   void status(const pipeline::PipelineStatus& st);
   /// rt/tf_static: base_link -> lidar, camera and thermal frames from the configured
@@ -144,7 +146,8 @@ class PoseSinks {
   HostTime next_path_stamp_;
   PathBuilder path_;
   /// With each pose: rt/tf (rate-limited) and the path (published at publish.path_rate_hz).
-  void ros_outputs(const NavState& s, const dds::PoseMessage& pose);
+  void ros_outputs(const NavState& s, const Eigen::Isometry3d& T_map_odom,
+                   const dds::PoseMessage& pose);
   PublishTally tally_;
   TopicLatency odom_latency_{"rt/posed/odom", {}, {}};
   TopicLatency pose_latency_{"rt/posed/pose", {}, {}};

@@ -54,12 +54,15 @@ dds::TfMessage static_transforms(const config::PosedConfig& config, WallTime sta
   return msg;
 }
 
-dds::TfMessage tf_tree(const config::DdsSection& dds, const NavState& s, WallTime stamp) {
+dds::TfMessage tf_tree(const config::DdsSection& dds, const NavState& s,
+                       const Eigen::Isometry3d& T_map_odom, WallTime stamp) {
   dds::TfMessage msg;
   msg.transforms.resize(2);
   msg.transforms[0].stamp = stamp;
   msg.transforms[0].parent_frame = dds.map_frame;
   msg.transforms[0].child_frame = dds.odom_frame;
+  msg.transforms[0].p_parent_child_m = T_map_odom.translation();
+  msg.transforms[0].q_parent_child = Eigen::Quaterniond(T_map_odom.rotation()).normalized();
   msg.transforms[1].stamp = stamp;
   msg.transforms[1].parent_frame = dds.odom_frame;
   msg.transforms[1].child_frame = dds.base_frame;

@@ -16,8 +16,9 @@ namespace posed {
 /// base_link -> lidar, colour camera and thermal camera frames from the configured extrinsics.
 dds::TfMessage static_transforms(const config::PosedConfig& config, WallTime stamp);
 
-/// map -> odom (identity: no map correction exists yet) -> base_link at `s`.
-dds::TfMessage tf_tree(const config::DdsSection& dds, const NavState& s, WallTime stamp);
+/// map -> odom (`T_map_odom`, the mapping stage's correction) -> base_link (`s`, in odom).
+dds::TfMessage tf_tree(const config::DdsSection& dds, const NavState& s,
+                       const Eigen::Isometry3d& T_map_odom, WallTime stamp);
 
 /// rt/diagnostics: one status per input stream ("posed: imu", ...) and one for the estimator,
 /// levels as diagnostic_msgs defines them.

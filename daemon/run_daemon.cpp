@@ -147,6 +147,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds::DdsConfig dds_config;
   dds_config.domain_id = static_cast<std::uint32_t>(config.dds.domain_id);
   dds_config.map_frame = config.dds.map_frame;
+  dds_config.odom_frame = config.dds.odom_frame;
   dds_config.base_frame = config.dds.base_frame;
   dds_config.cyclonedds_xml_path = config.dds.cyclonedds_config;
   dds_config.security = dds_security_files(config.dds.security);
@@ -231,7 +232,9 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   outputs.scan_observer = extra.scan_observer();
   outputs.frontend_observer = extra.frontend_observer();
   outputs.on_odom = [&sinks](const NavState& s) { sinks.odom(s); };
-  outputs.on_state = [&sinks](const NavState& s) { sinks.state(s); };
+  outputs.on_state = [&sinks](const NavState& s, const Eigen::Isometry3d& T_map_odom) {
+    sinks.state(s, T_map_odom);
+  };
   outputs.on_status = [&sinks](const pipeline::PipelineStatus& st) { sinks.status(st); };
 
   const bool built_has_lidar = built.sources.lidar != nullptr;

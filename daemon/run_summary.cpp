@@ -24,6 +24,37 @@ double yaw_deg(const Eigen::Quaterniond& q) {
 
 }  // namespace
 
+namespace {
+
+/// The mapping stage's line: loops closed, candidates refused and why, the correction, the cost.
+void print_mapping_summary(const pipeline::MappingFigures& m) {
+  const mapping::LoopClosureFigures& f = m.loops;
+  std::uint64_t by_descriptor = 0;
+  for (const mapping::LoopRecord& loop : m.accepted) by_descriptor += loop.by_descriptor ? 1 : 0;
+  const auto refused = [&](mapping::RegistrationVerdict v) {
+    return static_cast<unsigned long long>(f.rejected[static_cast<std::size_t>(v)]);
+  };
+  std::printf(
+      "  loops               %llu closed (%llu by descriptor) over %llu keyframes; refused: %llu "
+      "degenerate, %llu not close, %llu low overlap, %llu diverged, %llu unconfirmed\n",
+      static_cast<unsigned long long>(f.loops), static_cast<unsigned long long>(by_descriptor),
+      static_cast<unsigned long long>(f.keyframes),
+      refused(mapping::RegistrationVerdict::kDegenerate),
+      refused(mapping::RegistrationVerdict::kNotClose),
+      refused(mapping::RegistrationVerdict::kLowOverlap),
+      refused(mapping::RegistrationVerdict::kDiverged),
+      static_cast<unsigned long long>(f.unconfirmed));
+  std::printf(
+      "                      map -> odom %.3f m, %.2f deg; registration %.1f s in all, last "
+      "optimisation %.3f s; keyframe clouds %.1f M points%s\n",
+      m.T_map_odom.translation().norm(),
+      Eigen::AngleAxisd(m.T_map_odom.rotation()).angle() * 180.0 / M_PI, f.registration_time_s,
+      f.last_optimisation_s, static_cast<double>(f.stored_points) / 1e6,
+      m.keyframes_dropped > 0 ? " (some keyframes dropped: the mapping thread fell behind)" : "");
+}
+
+}  // namespace
+
 bool print_run_summary(const RunSummary& r) {
   const PublishTally& tally = r.sinks.tally();
   const pipeline::PipelineStatus st = r.pipe.status();
@@ -198,6 +229,7 @@ bool print_run_summary(const RunSummary& r) {
                 static_cast<unsigned long long>(rc.dropped));
   }
   if (!r.map_line.empty()) std::printf("  map                 %s\n", r.map_line.c_str());
+  if (const auto mapping = r.pipe.mapping_figures()) print_mapping_summary(*mapping);
   if (tally.last) {
     const NavState& s = *tally.last;
     std::printf("  final pose          x %.3f m, y %.3f m, z %.3f m, yaw %.1f deg\n",

@@ -24,18 +24,21 @@ double seconds_between(HostTime a, HostTime b) { return static_cast<double>(b.ns
 
 }  // namespace
 
-LoopCloser::LoopCloser(LoopClosureConfig config) : config_(std::move(config)) {}
+LoopCloser::LoopCloser(LoopClosureConfig config)
+    : config_(std::move(config)),
+      selector_(config_.keyframe_distance_m, config_.keyframe_angle_rad) {}
 
 bool LoopCloser::add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
                      std::span<const Eigen::Vector3f> points_base) {
-  if (!keyframes_.empty()) {
-    const Keyframe& last = keyframes_.back();
-    const Eigen::Isometry3d T_last_now = last.T_odom_base.inverse() * T_odom_base;
-    if (T_last_now.translation().norm() < config_.keyframe_distance_m &&
-        angle_of(T_last_now.rotation()) < config_.keyframe_angle_rad) {
-      return false;
-    }
+  if (!selector_.take(T_odom_base)) {
+    return false;
   }
+  add_keyframe(stamp, T_odom_base, points_base);
+  return true;
+}
+
+void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
+                              std::span<const Eigen::Vector3f> points_base) {
   Keyframe kf;
   kf.stamp = stamp;
   kf.T_odom_base = T_odom_base;
@@ -79,7 +82,6 @@ bool LoopCloser::add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
       index % static_cast<std::size_t>(config_.attempt_every_keyframes) == 0) {
     try_loop(index);
   }
-  return true;
 }
 
 std::optional<LoopCloser::Candidate> LoopCloser::distance_candidate(std::size_t query) const {

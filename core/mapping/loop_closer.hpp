@@ -21,6 +21,7 @@
 #include <span>
 #include <vector>
 
+#include "core/mapping/keyframe_selector.hpp"
 #include "core/mapping/pose_graph.hpp"
 #include "core/mapping/registration.hpp"
 #include "core/mapping/scan_context.hpp"
@@ -91,10 +92,16 @@ class LoopCloser {
   explicit LoopCloser(LoopClosureConfig config);
 
   /// One odometry pose and the scan at it (`points_base`: the deskewed scan in base_link at
-  /// `stamp`). Returns true when it became a keyframe. Poses must come in stamp order.
+  /// `stamp`). Returns true when it became a keyframe (KeyframeSelector with the config's
+  /// distance and angle). Poses must come in stamp order.
   bool add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
            std::span<const Eigen::Vector3f> points_base);
+  /// A pose a KeyframeSelector with the config's distance and angle already chose (the daemon
+  /// selects on the fusion thread and copies only those scans): becomes a keyframe.
+  void add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
+                    std::span<const Eigen::Vector3f> points_base);
 
+  const LoopClosureConfig& config() const { return config_; }
   /// The correction from the odometry frame onto the optimised map.
   const Eigen::Isometry3d& T_map_odom() const { return T_map_odom_; }
   /// Keyframe i's optimised pose (base_link in map).
@@ -137,6 +144,7 @@ class LoopCloser {
   void update_correction();
 
   LoopClosureConfig config_;
+  KeyframeSelector selector_;
   std::vector<Keyframe> keyframes_;
   PoseGraph graph_;
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();

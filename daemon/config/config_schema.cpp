@@ -527,6 +527,31 @@ const Field kSchema[] = {
       "TCP port of the Foxglove server (Foxglove Studio's default 8765; 0: any free port, logged)"),
     F("foxglove.max_queued_mb", foxglove.max_queued_mb, "8", "MB", 0.1, 1024, "",
       "messages queued per client before a slow client loses some (it alone)"),
+
+    F("mapping.loop_closure", mapping.loop_closure, "true", "", 0, 0, "",
+      "keep keyframes, close loops (Scan Context + GICP verification) in a pose graph on a "
+      "thread of its own, and publish the correction as map -> odom (rt/posed/pose in map)"),
+    F("mapping.min_separation_s", mapping.min_separation_s, "30", "s", 1, 3600, "",
+      "a loop joins keyframes at least this far apart in time"),
+    F("mapping.search_radius_m", mapping.search_radius_m, "8", "m", 0, 100, "",
+      "loop candidates by distance: an old keyframe this near the current estimate"),
+    F("mapping.scan_context_max_distance", mapping.scan_context_max_distance, "0.25", "", 0, 1, "",
+      "loop candidates by descriptor (drift beyond the search radius): Scan Context "
+      "distance at most this; such a loop must be confirmed by the next attempt"),
+    F("mapping.attempt_every_keyframes", mapping.attempt_every_keyframes, "2", "keyframes", 1, 1000,
+      "", "look for a loop at every n-th keyframe (registration is the expensive part)"),
+    F("mapping.keyframe_voxel_m", mapping.keyframe_voxel_m, "0.3", "m", 0.05, 5, "",
+      "keyframe clouds are kept thinned to one point per voxel of this size"),
+    F("mapping.max_rms_m", mapping.max_rms_m, "0.1", "m", 0.01, 2, "",
+      "a loop's registration must fit to this RMS point-to-plane distance"),
+    F("mapping.min_overlap", mapping.min_overlap, "0.5", "", 0, 1, "",
+      "and overlap this much (share of the query's points near the candidate's)"),
+    F("mapping.min_constraint", mapping.min_constraint, "0.02", "", 0, 1, "",
+      "and pin every direction of translation at least this much (share of the point-to-plane "
+      "information in its weakest direction): a plain corridor cannot close a loop along itself"),
+    F("mapping.queue_capacity", mapping.queue_capacity, "64", "scans", 4, 4096, "",
+      "scans waiting for the mapping thread; live, a keyframe that finds it full is left out "
+      "(counted; the graph bridges it by odometry), a replay waits"),
 };
 
 #undef F

@@ -275,6 +275,21 @@ struct FoxgloveSection {
   double max_queued_mb = 8;           ///< per client; beyond this a slow client loses messages
 };
 
+/// The mapping stage (core/mapping, docs/mapping.md): keyframes, loop closure, the pose graph and
+/// map -> odom. Keyframes are the estimator's (estimator.keyframe_distance_m, _angle_deg).
+struct MappingSection {
+  bool loop_closure = true;      ///< look for loops and publish map -> odom
+  double min_separation_s = 30;  ///< a loop joins keyframes at least this far apart [s]
+  double search_radius_m = 8;    ///< candidates by distance within this of the estimate [m]
+  double scan_context_max_distance = 0.25;  ///< candidates by descriptor at most this distance
+  int attempt_every_keyframes = 2;          ///< loops are looked for at every n-th keyframe [1]
+  double keyframe_voxel_m = 0.3;            ///< keyframe clouds kept at this resolution [m]
+  double max_rms_m = 0.1;                   ///< a verified loop's point-to-plane RMS at most [m]
+  double min_overlap = 0.5;                 ///< and its overlap at least [0..1]
+  double min_constraint = 0.02;  ///< and its weakest direction's information share [0..1]
+  int queue_capacity = 64;       ///< scans waiting for the mapping thread (live) [1]
+};
+
 struct WatchdogSection {
   double stage_deadline_s = 1.0;  ///< a stage silent this long stops WATCHDOG=1 [s]
 };
@@ -297,6 +312,7 @@ struct PosedConfig {
   QueuesSection queues;
   WatchdogSection watchdog;
   FoxgloveSection foxglove;
+  MappingSection mapping;
 };
 
 }  // namespace posed::config

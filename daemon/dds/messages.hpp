@@ -373,8 +373,10 @@ struct DdsSecurityFiles {
 struct DdsConfig {
   /// DDS domain (ROS_DOMAIN_ID) [-]
   std::uint32_t domain_id = 0;
-  /// header.frame_id of odom, pose and status
+  /// header.frame_id of pose, path and status
   std::string map_frame = "map";
+  /// rt/posed/odom's frame: odometry stays continuous in odom, loops move map -> odom (REP-105)
+  std::string odom_frame = "odom";
   /// child_frame_id of odom
   std::string base_frame = "base_link";
   /// Cyclone XML file used to create the domain; empty: CYCLONEDDS_URI or Cyclone's default.

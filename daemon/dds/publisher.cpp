@@ -25,6 +25,7 @@ struct Publisher::Impl {
   std::array<dds_entity_t, kAllTopics.size()> writers{};
   // Frame ids live here for the publisher's lifetime; the samples point into them.
   std::string map_frame;
+  std::string odom_frame;
   std::string base_frame;
   nav_msgs_msg_dds__Odometry_ odom_sample{};
   geometry_msgs_msg_dds__PoseStamped_ pose_sample{};
@@ -95,9 +96,10 @@ std::unique_ptr<Publisher> Publisher::create(const DdsConfig& config, std::strin
   if (!ok) return nullptr;  // ~Participant deletes whatever was created
 
   impl->map_frame = config.map_frame;
+  impl->odom_frame = config.odom_frame;
   impl->base_frame = config.base_frame;
   char* map_frame = impl->map_frame.data();
-  impl->odom_sample.header.frame_id = map_frame;
+  impl->odom_sample.header.frame_id = impl->odom_frame.data();
   impl->odom_sample.child_frame_id = impl->base_frame.data();
   impl->pose_sample.header.frame_id = map_frame;
   impl->status_sample.header.frame_id = map_frame;

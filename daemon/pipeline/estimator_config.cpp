@@ -79,4 +79,20 @@ StrapdownConfig strapdown_config(const config::PosedConfig& c) {
   };
 }
 
+mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config) {
+  const config::MappingSection& m = config.mapping;
+  mapping::LoopClosureConfig c;
+  c.keyframe_distance_m = config.estimator.keyframe_distance_m;
+  c.keyframe_angle_rad = config.estimator.keyframe_angle_deg * M_PI / 180.0;
+  c.keyframe_voxel_m = m.keyframe_voxel_m;
+  c.attempt_every_keyframes = m.attempt_every_keyframes;
+  c.min_separation_s = m.min_separation_s;
+  c.search_radius_m = m.search_radius_m;
+  c.scan_context_max_distance = m.scan_context_max_distance;
+  c.registration.max_rms_m = m.max_rms_m;
+  c.registration.min_overlap = m.min_overlap;
+  c.registration.min_constraint = m.min_constraint;
+  return c;
+}
+
 }  // namespace posed::pipeline

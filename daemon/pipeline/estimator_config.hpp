@@ -4,12 +4,15 @@
 
 #include "core/estimator/lio_estimator.hpp"
 #include "core/estimator/strapdown.hpp"
+#include "core/mapping/loop_closer.hpp"
 #include "daemon/config/posed_config.hpp"
 
 namespace posed::pipeline {
 
 estimator::LioConfig lio_config(const config::PosedConfig& config);
 StrapdownConfig strapdown_config(const config::PosedConfig& config);
+/// The mapping stage's loop closer: mapping.* and the estimator's keyframe spacing.
+mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config);
 
 /// A 4x4 row-major config transform as an isometry.
 Eigen::Isometry3d to_isometry(const config::Transform4& T);

@@ -52,7 +52,7 @@ FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<Fusi
                          FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
                          Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
                          FusionCounters& counters, OdometryHandover odometry,
-                         ScanObserver* scan_observer)
+                         std::vector<ScanObserver*> scan_observers)
     : config_(config),
       core_(std::move(core)),
       inputs_(inputs),
@@ -63,34 +63,46 @@ FusionStage::FusionStage(const config::PosedConfig& config, std::unique_ptr<Fusi
       heartbeat_(heartbeat),
       counters_(counters),
       odometry_(odometry),
-      scan_observer_(scan_observer),
+      scan_observers_(std::move(scan_observers)),
       failover_(Duration::from_seconds(config.realsense_imu.failover_after_s)) {
   // A scan can release a burst of states (the IMU samples it waited for); no allocation later.
   produced_.reserve(4096);
   outgoing_.reserve(4096);
+  produced_scans_before_.reserve(4096);
+  outgoing_scans_before_.reserve(4096);
+}
+
+void FusionStage::tag_new_states() {
+  produced_scans_before_.resize(produced_.size(), scans_handed_);
 }
 
 void FusionStage::route_states() {
-  for (NavState& state : produced_) {
+  tag_new_states();
+  for (std::size_t i = 0; i < produced_.size(); ++i) {
+    NavState& state = produced_[i];
     state.received = newest_received_;
-    if (odometry_.anchors == nullptr && odometry_.in_order == nullptr) {
-      outgoing_.push_back(state);
-      continue;
-    }
+    const bool decoupled = odometry_.anchors != nullptr || odometry_.in_order != nullptr;
     if (state.anchor && odometry_.anchors != nullptr) odometry_.anchors->push(AnchorItem{state});
     if (state.anchor && odometry_.in_order != nullptr) odometry_.in_order->set_anchor(state);
-    // The core's own propagation is replaced by the odometry path's.
-    if (state.optimised) outgoing_.push_back(state);
+    // With decoupled odometry, the core's own propagation is replaced by the odometry path's.
+    if (!decoupled || state.optimised) {
+      outgoing_.push_back(state);
+      outgoing_scans_before_.push_back(produced_scans_before_[i]);
+    }
   }
   counters_.states.fetch_add(produced_.size(), std::memory_order_relaxed);
   produced_.clear();
+  produced_scans_before_.clear();
 }
 
 void FusionStage::emit_states() {
   route_states();
   if (outgoing_.empty()) return;
-  for (const NavState& state : outgoing_) states_.push(StateItem{state, false});
+  for (std::size_t i = 0; i < outgoing_.size(); ++i) {
+    states_.push(StateItem{outgoing_[i], false, outgoing_scans_before_[i]});
+  }
   outgoing_.clear();
+  outgoing_scans_before_.clear();
   publisher_.signal();
 }
 
@@ -146,9 +158,11 @@ void FusionStage::hand_imu(const ImuItem& item) {
     if (odometry_.in_order->add_imu(item.sample, odom)) {
       odom.received = item.received;
       outgoing_.push_back(odom);
+      outgoing_scans_before_.push_back(scans_handed_);
     }
   }
   core_->add_imu(item.sample, produced_);
+  tag_new_states();
 }
 
 void FusionStage::note_imu_switch() {
@@ -238,14 +252,17 @@ void FusionStage::run() {
           ScanItem item = scans.take();
           took(1, item);
           core_->add_scan(std::move(item.scan), produced_);
+          ++scans_handed_;
+          tag_new_states();
           counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);
-          if (scan_observer_ != nullptr) scan_observer_->after_scan(*core_);
+          for (ScanObserver* observer : scan_observers_) observer->after_scan(*core_);
           break;
         }
         case Next::kVisible: {
           ImageItem item = visible.take();
           took(2, item);
           core_->add_image(CameraStream::kVisible, std::move(item.image), produced_);
+          tag_new_states();
           counters_.frames_fused[0].fetch_add(1, std::memory_order_relaxed);
           break;
         }
@@ -253,6 +270,7 @@ void FusionStage::run() {
           ImageItem item = thermal.take();
           took(3, item);
           core_->add_image(CameraStream::kThermal, std::move(item.image), produced_);
+          tag_new_states();
           counters_.frames_fused[1].fetch_add(1, std::memory_order_relaxed);
           break;
         }
@@ -274,6 +292,7 @@ void FusionStage::run() {
     if (!handed) inputs_ready_.wait_for(kStageWaitTimeout);
   }
   counters_.publish_figures(core_->figures());
+  for (ScanObserver* observer : scan_observers_) observer->after_last_scan();
   states_.push(StateItem{{}, true});
   publisher_.signal();
 }

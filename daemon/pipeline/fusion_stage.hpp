@@ -91,7 +91,7 @@ class FusionStage {
               FusionInputs inputs, bool in_stamp_order, SpscQueue<StateItem>& states,
               Wakeup& inputs_ready, Wakeup& publisher, Heartbeat& heartbeat,
               FusionCounters& counters, OdometryHandover odometry = {},
-              ScanObserver* scan_observer = nullptr);
+              std::vector<ScanObserver*> scan_observers = {});
   /// Runs until every input stream has ended, then forwards end-of-stream to the publisher.
   void run();
   const FusionCore& core() const { return *core_; }
@@ -119,7 +119,14 @@ class FusionStage {
   Heartbeat& heartbeat_;
   FusionCounters& counters_;
   OdometryHandover odometry_;
-  ScanObserver* scan_observer_;
+  std::vector<ScanObserver*> scan_observers_;
+  /// scans handed to the core so far [1]
+  std::uint64_t scans_handed_ = 0;
+  /// per state in produced_ / outgoing_: scans_handed_ when the core made it
+  std::vector<std::uint64_t> produced_scans_before_;
+  std::vector<std::uint64_t> outgoing_scans_before_;
+  /// Tags the states the last core call appended to produced_ with scans_handed_.
+  void tag_new_states();
   std::vector<NavState> produced_;
   /// states for the publisher, routed from produced_
   std::vector<NavState> outgoing_;

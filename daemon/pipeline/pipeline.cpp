@@ -231,19 +231,29 @@ bool Pipeline::start(std::string& error) {
       handover.anchors = anchor_queue_.get();
     }
   }
+  // Loops and map -> odom on a thread of their own, from the lidar-inertial estimate's scans.
+  std::vector<ScanObserver*> scan_observers;
+  if (outputs_.scan_observer != nullptr) scan_observers.push_back(outputs_.scan_observer);
+  if (config_.mapping.loop_closure && lio != nullptr) {
+    add_stage("mapping", [&](Heartbeat& beat) {
+      mapping_stage_ = std::make_unique<MappingStage>(config_, in_stamp_order, beat);
+      return [this] { mapping_stage_->run(); };
+    });
+    scan_observers.push_back(mapping_stage_.get());
+  }
   add_stage("fusion", [&](Heartbeat& beat) {
     fusion_stage_ = std::make_unique<FusionStage>(
         config_, std::move(core),
         FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get(),
                      backup_imu_queue_.get()},
         in_stamp_order, state_queue_, fusion_ready_, state_ready_, beat, *fusion_counters_,
-        handover, outputs_.scan_observer);
+        handover, std::move(scan_observers));
     return [this] { fusion_stage_->run(); };
   });
   add_stage("publisher", [&](Heartbeat& beat) {
-    publisher_stage_ = std::make_unique<PublisherStage>(config_, state_queue_, state_ready_, beat,
-                                                        outputs_.on_state, outputs_.on_status,
-                                                        [this] { return status(); });
+    publisher_stage_ = std::make_unique<PublisherStage>(
+        config_, state_queue_, state_ready_, beat, outputs_.on_state, outputs_.on_status,
+        [this] { return status(); }, mapping_stage_.get());
     return [this] { publisher_stage_->run(); };
   });
 
@@ -302,6 +312,11 @@ void Pipeline::join() {
 
 void Pipeline::export_map(MapExport& out) const {
   if (fusion_stage_) fusion_stage_->core().export_map(out);
+}
+
+std::optional<MappingFigures> Pipeline::mapping_figures() const {
+  if (!mapping_stage_) return std::nullopt;
+  return mapping_stage_->figures();
 }
 
 std::vector<CameraFigures> Pipeline::camera_compare_figures() const {

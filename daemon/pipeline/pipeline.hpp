@@ -16,6 +16,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,8 +26,10 @@
 #include "core/spsc_queue.hpp"
 #include "core/time.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/mapping_stage.hpp"
 #include "daemon/pipeline/odometry_path.hpp"
 #include "daemon/pipeline/pipeline_status.hpp"
+#include "daemon/pipeline/publisher_stage.hpp"
 #include "daemon/pipeline/scan_observer.hpp"
 #include "daemon/pipeline/stage_support.hpp"
 #include "daemon/pipeline/wakeup.hpp"
@@ -92,8 +95,9 @@ struct PipelineSources {
 /// Callbacks run on the publisher thread.
 struct PipelineOutputs {
   /// every state (the daemon publishes propagation on rt/posed/odom and optimised states, or
-  /// decimated propagation, on rt/posed/pose); without the odometry below, the propagation too
-  std::function<void(const NavState&)> on_state;
+  /// decimated propagation, on rt/posed/pose); without the odometry below, the propagation too.
+  /// With the mapping stage's map -> odom for the state (identity without one).
+  StateCallback on_state;
   /// IMU-rate odometry kept apart from the back end (publish.odom_decoupled, with a lidar),
   /// called on the IMU stage's thread; in max-speed replays it comes through on_state instead
   /// (made in data order on the fusion thread). Null: the core's own propagation, on_state.
@@ -114,7 +118,8 @@ struct PipelineOutputs {
 
 /// One stage's last sign of life, for the systemd watchdog.
 struct StageBeat {
-  std::string name;  ///< "imu_source", "lidar_source", "visible_source", "fusion", "publisher"
+  /// "imu_source", "lidar_source", "visible_source", "mapping", "fusion", "publisher"
+  std::string name;
   HostTime last;
 };
 
@@ -151,6 +156,8 @@ class Pipeline {
   std::string estimator_description() const;
   /// The fusion core's map and keyframes (call after join(); empty without a lidar or keep_map).
   void export_map(MapExport& out) const;
+  /// The mapping stage's loops and map -> odom (safe from any thread; nullopt without one).
+  std::optional<MappingFigures> mapping_figures() const;
   /// The comparison front ends' figures (call after join(); empty without them).
   std::vector<CameraFigures> camera_compare_figures() const;
 
@@ -200,6 +207,8 @@ class Pipeline {
   /// the fusion core when it has cameras (owned by fusion_stage_)
   const fusion::CameraAidedCore* camera_core_ = nullptr;
   std::unique_ptr<PublisherStage> publisher_stage_;
+  /// loop closure and map -> odom (mapping.loop_closure, with the lidar-inertial estimator)
+  std::unique_ptr<MappingStage> mapping_stage_;
   /// odometry apart from the back end, live: its anchors and the IMU stage's path
   std::unique_ptr<SpscQueue<AnchorItem>> anchor_queue_;
   std::unique_ptr<OdometryPath> odometry_;

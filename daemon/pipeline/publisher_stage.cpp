@@ -1,20 +1,21 @@
 #include "daemon/pipeline/publisher_stage.hpp"
 
+#include "daemon/pipeline/mapping_stage.hpp"
 #include "daemon/pipeline/thread_policy.hpp"
 #include "drivers/common/host_clock.hpp"
 
 namespace posed::pipeline {
 
 PublisherStage::PublisherStage(const config::PosedConfig& config, SpscQueue<StateItem>& states,
-                               Wakeup& ready, Heartbeat& heartbeat,
-                               std::function<void(const NavState&)> on_state,
+                               Wakeup& ready, Heartbeat& heartbeat, StateCallback on_state,
                                std::function<void(const PipelineStatus&)> on_status,
-                               std::function<PipelineStatus()> snapshot)
+                               std::function<PipelineStatus()> snapshot, MappingStage* mapping)
     : config_(config),
       states_(states),
       ready_(ready),
       heartbeat_(heartbeat),
       on_state_(std::move(on_state)),
+      mapping_(mapping),
       on_status_(std::move(on_status)),
       snapshot_(std::move(snapshot)) {}
 
@@ -46,7 +47,17 @@ void PublisherStage::run() {
         done = true;
         break;
       }
-      if (on_state_) on_state_(item.state);
+      if (!on_state_) continue;
+      if (mapping_ == nullptr) {
+        on_state_(item.state, Eigen::Isometry3d::Identity());
+        continue;
+      }
+      // In data order the correction waits for the mapping stage to reach the state; the
+      // watchdog must see this thread alive meanwhile.
+      while (!mapping_->wait_until_taken(item.scans_before, kStageWaitTimeout)) {
+        heartbeat_.beat();
+      }
+      on_state_(item.state, mapping_->T_map_odom(item.scans_before));
     }
     const HostTime now = drivers::host_now();
     if (done || now >= next_status) {

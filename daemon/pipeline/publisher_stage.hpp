@@ -1,7 +1,9 @@
 #pragma once
-// The publisher stage (one thread): hands every state to the daemon's output callback (DDS,
-// recorder) and, at the status rate, a status snapshot with per-stream rates.
+// The publisher stage (one thread): hands every state, with the mapping stage's map -> odom for
+// it, to the daemon's output callback (DDS, recorder) and, at the status rate, a status snapshot
+// with per-stream rates.
 
+#include <Eigen/Geometry>
 #include <functional>
 
 #include "core/spsc_queue.hpp"
@@ -12,12 +14,18 @@
 
 namespace posed::pipeline {
 
+class MappingStage;
+
+/// A state in the odometry frame and the map -> odom correction that applies to it (identity
+/// without a mapping stage).
+using StateCallback = std::function<void(const NavState&, const Eigen::Isometry3d& T_map_odom)>;
+
 class PublisherStage {
  public:
   PublisherStage(const config::PosedConfig& config, SpscQueue<StateItem>& states, Wakeup& ready,
-                 Heartbeat& heartbeat, std::function<void(const NavState&)> on_state,
+                 Heartbeat& heartbeat, StateCallback on_state,
                  std::function<void(const PipelineStatus&)> on_status,
-                 std::function<PipelineStatus()> snapshot);
+                 std::function<PipelineStatus()> snapshot, MappingStage* mapping = nullptr);
   /// Runs until end-of-stream arrives; a last status follows it.
   void run();
 
@@ -28,7 +36,8 @@ class PublisherStage {
   SpscQueue<StateItem>& states_;
   Wakeup& ready_;
   Heartbeat& heartbeat_;
-  std::function<void(const NavState&)> on_state_;
+  StateCallback on_state_;
+  MappingStage* mapping_;
   std::function<void(const PipelineStatus&)> on_status_;
   std::function<PipelineStatus()> snapshot_;
   PipelineStatus previous_;

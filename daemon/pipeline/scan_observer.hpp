@@ -12,6 +12,8 @@ class ScanObserver {
   virtual ~ScanObserver() = default;
   /// Right after the core was handed a scan (which it may not have matched yet, or at all).
   virtual void after_scan(const FusionCore& core) = 0;
+  /// After the last scan: the fusion stage has ended.
+  virtual void after_last_scan() {}
 };
 
 }  // namespace posed::pipeline

@@ -56,6 +56,9 @@ struct ImageItem {
 struct StateItem {
   NavState state;
   bool end_of_stream = false;
+  /// scans the fusion stage had handed the core when the core made the state: where the mapping
+  /// stage's correction for it stands (mapping_stage.hpp)
+  std::uint64_t scans_before = 0;
 };
 
 /// The last sign of life of one stage thread, on the host clock.

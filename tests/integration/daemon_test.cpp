@@ -71,7 +71,7 @@ TEST(Daemon, PublishesOdomThatFollowsTheKnownMotionAndStopsOnSigterm) {
   WallTime previous_stamp;
   for (const auto& r : odom) {
     const auto& m = r.msg;
-    EXPECT_EQ(r.frame_id, "map");
+    EXPECT_EQ(r.frame_id, "odom");  // REP-105: odometry is continuous in odom
     EXPECT_EQ(r.child_frame_id, "base_link");
     EXPECT_GT(m.stamp, previous_stamp);
     previous_stamp = m.stamp;

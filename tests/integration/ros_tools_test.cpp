@@ -102,7 +102,7 @@ TEST(Ros2Tools, CloudsInTheVelodyneLayoutOnePerScanAndTheMapForALateJoiner) {
     reader->take_cloud(dds::Topic::kCloud, clouds);  // keep up: the reader holds 2 at most
   }
   ASSERT_EQ(maps.size(), 1u) << "a late joiner gets the latest map, and only that";
-  EXPECT_EQ(maps[0].frame_id, "map");
+  EXPECT_EQ(maps[0].frame_id, "odom");
   EXPECT_EQ(maps[0].msg.point_step, 12u);
   EXPECT_GT(maps[0].msg.width, 1000u);
 
@@ -282,7 +282,7 @@ TEST(Ros2Tools, FoxglovesOwnClientGetsAndDecodesEveryTopic) {
   EXPECT_EQ(sent.at("/posed/cloud"),
             hil_helpers::number_after(posed.out(), "  point clouds        "));
   EXPECT_EQ(channels["/posed/odom"]["schemaName"], "nav_msgs/msg/Odometry");
-  EXPECT_EQ(channels["/posed/odom"]["last"]["frameId"], "map");
+  EXPECT_EQ(channels["/posed/odom"]["last"]["frameId"], "odom");
   EXPECT_EQ(channels["/tf"]["last"]["transforms"],
             nlohmann::json::array({"map->odom", "odom->base_link"}));
   EXPECT_EQ(channels["/tf_static"]["messages"], 1);
@@ -293,7 +293,7 @@ TEST(Ros2Tools, FoxglovesOwnClientGetsAndDecodesEveryTopic) {
   EXPECT_EQ(cloud["fields"], nlohmann::json::array({"x:7@0", "y:7@4", "z:7@8", "intensity:7@12",
                                                     "ring:4@16", "time:7@18"}));
   EXPECT_EQ(cloud["dataBytes"].get<long long>(), cloud["width"].get<long long>() * 22);
-  EXPECT_EQ(channels["/posed/map"]["last"]["frameId"], "map");
+  EXPECT_EQ(channels["/posed/map"]["last"]["frameId"], "odom");
   EXPECT_EQ(channels["/diagnostics"]["last"]["statuses"][0], "posed: imu");
 }
 

@@ -143,7 +143,7 @@ TEST(CanReplay, ACandumpImportReplaysIntoTheFusionCore) {
   std::vector<NavState> states;
   pipeline::PipelineStatus status;
   pipeline::PipelineOutputs outputs;
-  outputs.on_state = [&](const NavState& s) {
+  outputs.on_state = [&](const NavState& s, const Eigen::Isometry3d&) {
     std::lock_guard lock(m);
     states.push_back(s);
   };

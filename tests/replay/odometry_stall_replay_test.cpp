@@ -96,7 +96,7 @@ TEST(OdometryStallReplay, OdomKeepsFlowingWhileTheLidarStageIsStalledAndTheWatch
     std::lock_guard lock(m);
     odom_host_ns.push_back(drivers::host_now().ns);
   };
-  outputs.on_state = [&](const NavState& s) {
+  outputs.on_state = [&](const NavState& s, const Eigen::Isometry3d&) {
     std::lock_guard lock(m);
     if (s.optimised) pose_host_ns.push_back(drivers::host_now().ns);
   };

@@ -195,7 +195,7 @@ int run_inspect_frontend(int argc, char** argv) {
   observers.add(truth.get());
   observers.add(&timeline);
   pipeline::PipelineOutputs outputs;
-  outputs.on_state = [](const NavState&) {};
+  outputs.on_state = [](const NavState&, const Eigen::Isometry3d&) {};
   outputs.on_status = [](const pipeline::PipelineStatus&) {};
   for (const vision::FrontendMode m : kModes) {
     if (m != primary.frontend.mode) outputs.frontend_compare_modes.push_back(m);

@@ -150,7 +150,7 @@ TEST(CloudOutput, ScansAndTheMapReachASeparateReaderWithEveryPoint) {
     EXPECT_EQ(field_at<std::uint16_t>(r.msg, 4999, 16), 4999 % 32);
   }
   EXPECT_EQ(clouds.back().msg.stamp, WallTime::from_ns(300'000'000));
-  EXPECT_EQ(maps.front().frame_id, "map");
+  EXPECT_EQ(maps.front().frame_id, "odom");  // the estimator's local map
   EXPECT_EQ(maps.front().msg.width, 1234u);
   EXPECT_EQ(maps.front().msg.point_step, 12u);
 }

@@ -78,7 +78,7 @@ TEST(DdsCrossProcess, ForkedPublisherReachesSubscriber) {
       if (r.msg.stamp == stamp) {
         got = true;
         EXPECT_EQ(r.msg.p_map_base_m, Eigen::Vector3d(7, 8, 9));
-        EXPECT_EQ(r.frame_id, "map");
+        EXPECT_EQ(r.frame_id, "odom");
       }
     }
     samples.clear();

@@ -44,6 +44,7 @@ class DdsPubSub : public ::testing::Test {
   void SetUp() override {
     config_ = test::loopback_config();
     config_.map_frame = "world";
+    config_.odom_frame = "world_odom";
     config_.base_frame = "robot";
     std::string error;
     publisher_ = Publisher::create(config_, error);
@@ -78,7 +79,7 @@ TEST_F(DdsPubSub, OdomArrivesIntactWithConfiguredFrames) {
                                                  [&](auto& out) { subscriber_->take_odom(out); });
   ASSERT_EQ(got.size(), 1u);
   const auto& r = got[0];
-  EXPECT_EQ(r.frame_id, "world");
+  EXPECT_EQ(r.frame_id, "world_odom");
   EXPECT_EQ(r.child_frame_id, "robot");
   EXPECT_EQ(r.msg.p_map_base_m, msg.p_map_base_m);
   EXPECT_EQ(r.msg.q_map_base.coeffs(), msg.q_map_base.coeffs());
@@ -210,7 +211,7 @@ TEST(DdsPlainReader, ReceivesPublisherOdomByRosTypeAndTopicName) {
           std::int64_t{odom->header.stamp.sec} * 1'000'000'000 + odom->header.stamp.nanosec;
       if (info.valid_data && ns == msg.stamp.ns) {
         found = true;
-        EXPECT_STREQ(odom->header.frame_id, "map");
+        EXPECT_STREQ(odom->header.frame_id, "odom");
         EXPECT_STREQ(odom->child_frame_id, "base_link");
         EXPECT_EQ(odom->pose.pose.position.y, 5.0);
         EXPECT_EQ(odom->pose.pose.orientation.w, 1.0);

@@ -71,7 +71,7 @@ RunResult run(std::unique_ptr<drivers::Source> source, const config::PosedConfig
   RunResult result;
   std::mutex m;
   PipelineOutputs outputs;
-  outputs.on_state = [&](const NavState& s) {
+  outputs.on_state = [&](const NavState& s, const Eigen::Isometry3d&) {
     std::lock_guard lock(m);
     result.states.push_back(s);
   };

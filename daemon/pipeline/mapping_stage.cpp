@@ -1,0 +1,141 @@
+#include "daemon/pipeline/mapping_stage.hpp"
+
+#include "daemon/pipeline/estimator_config.hpp"
+#include "daemon/pipeline/thread_policy.hpp"
+#include "drivers/common/log.hpp"
+
+namespace posed::pipeline {
+
+MappingStage::MappingStage(const config::PosedConfig& config, bool in_data_order,
+                           Heartbeat& heartbeat)
+    : in_data_order_(in_data_order),
+      capacity_(static_cast<std::size_t>(config.mapping.queue_capacity)),
+      T_base_lidar_(to_isometry(config.extrinsics.T_imu_lidar)),
+      heartbeat_(heartbeat),
+      closer_(loop_closure_config(config)),
+      selector_(closer_.config().keyframe_distance_m, closer_.config().keyframe_angle_rad) {
+  corrections_.emplace_back(0, Eigen::Isometry3d::Identity());
+}
+
+void MappingStage::after_scan(const FusionCore& core) {
+  Item item;
+  MatchedScan scan;
+  // A scan the core did not match (yet, or at all) is still one item: states count scans.
+  if (core.latest_matched_scan(scan) && scan.index != last_scan_index_) {
+    last_scan_index_ = scan.index;
+    const Eigen::Isometry3d T_odom_base = scan.T_map_lidar * T_base_lidar_.inverse();
+    if (selector_.take(T_odom_base)) {
+      item.keyframe = true;
+      item.stamp = scan.stamp;
+      item.T_odom_base = T_odom_base;
+      item.points_base.reserve(scan.points_lidar.size());
+      const Eigen::Isometry3f T_base_lidar = T_base_lidar_.cast<float>();
+      for (const lidar::ScanPoint& p : scan.points_lidar) {
+        item.points_base.push_back(T_base_lidar * p.p);
+      }
+    }
+  }
+  push(std::move(item));
+}
+
+void MappingStage::after_last_scan() {
+  Item item;
+  item.last = true;
+  push(std::move(item));
+}
+
+void MappingStage::push(Item item) {
+  {
+    std::unique_lock lock(mutex_);
+    if (in_data_order_) {
+      // A replay waits for the mapping thread rather than lose a keyframe.
+      progress_.wait(lock, [this] { return queue_.size() < capacity_; });
+    } else if (queue_.size() >= capacity_ && item.keyframe) {
+      // Live, the fusion thread never waits: the keyframe's cloud is let go (the scan still
+      // counts, so later states find their place), and the graph bridges the gap by odometry.
+      item.keyframe = false;
+      item.points_base = {};
+      ++figures_.keyframes_dropped;
+    }
+    queue_.push_back(std::move(item));
+  }
+  item_ready_.notify_one();
+}
+
+void MappingStage::run() {
+  apply_thread_policy("posed-mapping", config::ThreadSection{});
+  for (;;) {
+    heartbeat_.beat();
+    Item item;
+    {
+      std::unique_lock lock(mutex_);
+      if (!item_ready_.wait_for(lock, kStageWaitTimeout, [this] { return !queue_.empty(); })) {
+        continue;
+      }
+      item = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    progress_.notify_all();  // room in the queue
+    if (item.last) {
+      std::lock_guard lock(mutex_);
+      ended_ = true;
+      break;
+    }
+    const std::size_t loops_before = closer_.loops().size();
+    if (item.keyframe) {
+      closer_.add_keyframe(item.stamp, item.T_odom_base, item.points_base);
+    }
+    const std::size_t loops_now = closer_.loops().size();
+    {
+      std::lock_guard lock(mutex_);
+      ++taken_;
+      ++figures_.scans;
+      figures_.loops = closer_.figures();
+      if (loops_now != loops_before) {
+        corrections_.emplace_back(taken_, closer_.T_map_odom());
+        figures_.accepted = closer_.loops();
+        figures_.T_map_odom = closer_.T_map_odom();
+      }
+    }
+    if (loops_now != loops_before) {
+      const mapping::LoopRecord& loop = closer_.loops().back();
+      POSED_LOG_NOTICE(
+          "mapping: loop %zu at %.3f s: keyframe %zu -> %zu (%s), fit %.3f m, overlap %.2f, "
+          "correction %.2f m; map -> odom now %.2f m off",
+          loops_now, loop.stamp.seconds(), loop.query, loop.candidate,
+          loop.by_descriptor ? "descriptor" : "distance", loop.rms_m, loop.overlap,
+          loop.correction_m, closer_.T_map_odom().translation().norm());
+    }
+    progress_.notify_all();
+  }
+  progress_.notify_all();
+}
+
+bool MappingStage::wait_until_taken(std::uint64_t scans, std::chrono::milliseconds timeout) {
+  if (!in_data_order_) {
+    return true;
+  }
+  std::unique_lock lock(mutex_);
+  return progress_.wait_for(lock, timeout, [&] { return taken_ >= scans || ended_; });
+}
+
+Eigen::Isometry3d MappingStage::T_map_odom(std::uint64_t scans_before) const {
+  std::lock_guard lock(mutex_);
+  if (!in_data_order_) {
+    return corrections_.back().second;
+  }
+  // The newest correction that took effect by then.
+  for (auto it = corrections_.rbegin(); it != corrections_.rend(); ++it) {
+    if (it->first <= scans_before) {
+      return it->second;
+    }
+  }
+  return Eigen::Isometry3d::Identity();
+}
+
+MappingFigures MappingStage::figures() const {
+  std::lock_guard lock(mutex_);
+  return figures_;
+}
+
+}  // namespace posed::pipeline

@@ -1,0 +1,89 @@
+#pragma once
+// The mapping stage (one thread; DESIGN.md, Data flow: mapping → tf map→odom). On the fusion
+// thread, after every scan, it copies the newest matched scan when it is a keyframe (the
+// estimator's keyframe spacing) and queues it; its own thread feeds core/mapping's LoopCloser,
+// which verifies loops and optimises the pose graph off the real-time path. What comes out is
+// map -> odom, which the publisher applies to rt/posed/pose and rt/tf.
+//
+// Order. Every scan the fusion stage hands the core is one item here, keyframe or not, and every
+// state carries how many scans came before it (StateItem::scans_before). Live, a state gets the
+// newest correction there is: odometry and poses never wait for a registration. In a replay in
+// data order the publisher waits until this stage has taken the scans before the state and uses
+// the correction as it stood then, so a max-speed replay puts the same poses in the map frame on
+// every run however the threads were scheduled.
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <vector>
+
+#include "core/mapping/loop_closer.hpp"
+#include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/scan_observer.hpp"
+#include "daemon/pipeline/stage_support.hpp"
+
+namespace posed::pipeline {
+
+struct MappingFigures {
+  mapping::LoopClosureFigures loops;
+  std::vector<mapping::LoopRecord> accepted;  ///< every accepted loop, oldest first
+  Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
+  std::uint64_t scans = 0;              ///< scans the stage was shown [1]
+  std::uint64_t keyframes_dropped = 0;  ///< live: keyframes the full queue refused [1]
+};
+
+class MappingStage final : public ScanObserver {
+ public:
+  /// `in_data_order`: a replay whose poses must not depend on thread timing (see above).
+  MappingStage(const config::PosedConfig& config, bool in_data_order, Heartbeat& heartbeat);
+
+  /// Fusion thread, after every scan handed to the core.
+  void after_scan(const FusionCore& core) override;
+  /// Fusion thread: no scan follows; the stage's thread ends once it has taken the queue.
+  void after_last_scan() override;
+  /// The stage's thread.
+  void run();
+
+  /// Publisher thread, in data order: waits up to `timeout` for the stage to take the first
+  /// `scans` scans; true once it has (at once live, and once the stage has ended).
+  bool wait_until_taken(std::uint64_t scans, std::chrono::milliseconds timeout);
+  /// Publisher thread: map -> odom for a state made after `scans_before` scans: in data order
+  /// the correction as it stood once the stage had taken them (wait_until_taken() first); live,
+  /// the newest.
+  Eigen::Isometry3d T_map_odom(std::uint64_t scans_before) const;
+  MappingFigures figures() const;
+
+ private:
+  struct Item {
+    bool keyframe = false;
+    bool last = false;  ///< after_last_scan(): nothing follows
+    HostTime stamp;
+    Eigen::Isometry3d T_odom_base = Eigen::Isometry3d::Identity();
+    std::vector<Eigen::Vector3f> points_base;
+  };
+  void push(Item item);
+
+  const bool in_data_order_;
+  const std::size_t capacity_;
+  const Eigen::Isometry3d T_base_lidar_;
+  Heartbeat& heartbeat_;
+  mapping::LoopCloser closer_;  ///< the stage's thread only
+  // Fusion thread only.
+  mapping::KeyframeSelector selector_;
+  std::uint64_t last_scan_index_ = 0;
+
+  mutable std::mutex mutex_;
+  std::condition_variable item_ready_;  ///< the stage's thread waits for items
+  std::condition_variable progress_;    ///< the fusion and publisher threads wait for it
+  std::deque<Item> queue_;
+  std::uint64_t taken_ = 0;  ///< items (scans) the stage's thread has finished [1]
+  bool ended_ = false;       ///< the last item was taken
+  /// (items taken when it took effect, map -> odom), one entry per change, oldest first
+  std::vector<std::pair<std::uint64_t, Eigen::Isometry3d>> corrections_;
+  MappingFigures figures_;
+};
+
+}  // namespace posed::pipeline
