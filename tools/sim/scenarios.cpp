@@ -1,10 +1,12 @@
 #include "tools/sim/scenarios.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
 
+#include "tools/sim/campus.hpp"
 #include "tools/sim/path_layout.hpp"
 #include "tools/sim/roadway.hpp"
 #include "tools/sim/scenario_random.hpp"
@@ -121,6 +123,39 @@ Trajectory drive(Rng& rng, const PeriodicSpline2& path, const DriveStyle& style,
   SpeedProfile speed = make_speed(rng, duration_s, style.static_s, style.v_min_mps, style.v_max_mps,
                                   style.accel_mps2, style.stop_probability);
   return Trajectory(path, std::move(speed), std::move(bumps));
+}
+
+/// A drive's own random stream, apart from the world's, for `--drive-seed` (`salt` as
+/// begin_scenario's: one per scenario).
+Rng drive_stream(std::uint64_t drive_seed, std::uint64_t salt) {
+  return Rng(drive_seed * 0x9E3779B97F4A7C15ull + salt);
+}
+
+/// Where a drive goes on a road whose centre line is `road`: from a start drawn along the loop
+/// outside [avoid_from_u_m, avoid_from_u_m + avoid_length_m] (where the estimators had better
+/// not initialise), in a direction drawn at random, at an offset from the centre line within
+/// ±max_offset_m that weaves slowly (nobody holds a line to the centimetre). Draws the start,
+/// the direction, then the offset and its weave.
+PeriodicSpline2 lane_path(Rng& rng, const PeriodicSpline2& road, double max_offset_m,
+                          double avoid_from_u_m, double avoid_length_m) {
+  const double L = road.length();
+  const double u0 = avoid_from_u_m + avoid_length_m + uniform(rng, 0, L - avoid_length_m);
+  const double direction = rng() % 2 == 0 ? 1.0 : -1.0;
+  const double weave = uniform(rng, 0, 0.25) * max_offset_m;
+  const double offset = uniform(rng, -1, 1) * (max_offset_m - weave);
+  // A whole number of weaves, each 80-200 m long, per lap: the line closes on itself.
+  const double weaves = std::max(1.0, std::round(L / uniform(rng, 80, 200)));
+  const double phase = uniform(rng, 0, 2 * kPi);
+  // Waypoints every ~4 m: the spline through them follows bends of 17 m radius within
+  // millimetres.
+  const int n = static_cast<int>(std::ceil(L / 4.0));
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < n; ++i) {
+    const double s = L * i / n;  // along the drive [m]
+    const PathFrame f = path_frame(road, u0 + direction * s);
+    pts.push_back(f.p + (offset + weave * std::sin(2 * kPi * weaves * s / L + phase)) * f.n);
+  }
+  return PeriodicSpline2(pts);
 }
 
 Scenario room(std::uint64_t seed, double duration_s, double g) {
@@ -279,7 +314,8 @@ Scenario mine(std::uint64_t seed, double duration_s, double g) {
   return s;
 }
 
-Scenario street_night(std::uint64_t seed, double duration_s, double g) {
+Scenario street_night(std::uint64_t seed, std::optional<std::uint64_t> drive_seed,
+                      double duration_s, double g) {
   Rng rng;
   Scenario s = begin_scenario("street_night", seed, 4,
                               {.ambient = 0.01,
@@ -346,14 +382,22 @@ Scenario street_night(std::uint64_t seed, double duration_s, double g) {
       w.add_yawed({c.x(), c.y(), 0.85}, {0.25, 0.2, 0.85}, f.yaw, person);
     }
   }
-  s.trajectory = drive(rng, path,
-                       {.v_min_mps = 2.0,
-                        .v_max_mps = 6.0,
-                        .accel_mps2 = 0.8,
-                        .stop_probability = 0.12,
-                        .bump_z_m = 0.008,
-                        .bump_angle_rad = 0.006},
-                       duration_s, g);
+  const DriveStyle style{.v_min_mps = 2.0,
+                         .v_max_mps = 6.0,
+                         .accel_mps2 = 0.8,
+                         .stop_probability = 0.12,
+                         .bump_z_m = 0.008,
+                         .bump_angle_rad = 0.006};
+  if (!drive_seed) {
+    // Along the centre line from u = 0, drawn from the world's stream after the world: the drive
+    // this scenario has always had for a seed.
+    s.trajectory = drive(rng, path, style, duration_s, g);
+    return s;
+  }
+  // Another drive in the same world: within 0.6 m of the centre line, which keeps a metre from
+  // the parked cars (the nearest things, 1.6 m from it on the inside of bends).
+  Rng drive_rng = drive_stream(*drive_seed, 0x104);
+  s.trajectory = drive(drive_rng, lane_path(drive_rng, path, 0.6, 0, 0), style, duration_s, g);
   return s;
 }
 
@@ -413,8 +457,38 @@ Scenario smoke(std::uint64_t seed, double duration_s, double g) {
   return s;
 }
 
-constexpr std::array<std::string_view, 6> kNames = {"street_night", "corridor", "mine",
-                                                    "room",         "tunnel",   "smoke"};
+/// A campus by day (campus.hpp): a figure-of-eight ring road, 630-780 m around, with an open
+/// stretch by a sports field. The drive comes from its own stream, seeded by the drive seed
+/// (the world's seed unless another is given): anywhere on the road but the open stretch, in
+/// either direction, within 2 m of the centre line (1.5 m from the kerbs).
+Scenario campus(std::uint64_t seed, std::optional<std::uint64_t> drive_seed, double duration_s,
+                double g) {
+  Rng rng;
+  Scenario s = begin_scenario(
+      "campus", seed, 7,
+      {.ambient = 1.0, .sky_radiance = 0.9, .air_temperature_c = 18, .sky_temperature_c = -8}, rng);
+  // Sunlit paving, warmer than the air.
+  add_ground(s.world,
+             s.world.add_material({20, 0.3, kTextureNoise, 0.35, 26, 0, {0.75, 0.78, 0.8}}));
+  const CampusShape shape = build_campus(s.world, rng);
+  Rng drive_rng = drive_stream(drive_seed.value_or(seed), 0x107);
+  // The start keeps 50 m from the open stretch: the estimators initialise, and drive their
+  // first seconds, where the lidar sees something.
+  const PeriodicSpline2 lane = lane_path(drive_rng, shape.road, shape.road_half_width_m - 1.5,
+                                         shape.open_from_u_m - 50, shape.open_length_m + 100);
+  s.trajectory = drive(drive_rng, lane,
+                       {.v_min_mps = 2.0,
+                        .v_max_mps = 4.0,
+                        .accel_mps2 = 0.8,
+                        .stop_probability = 0.1,
+                        .bump_z_m = 0.006,
+                        .bump_angle_rad = 0.005},
+                       duration_s, g);
+  return s;
+}
+
+constexpr std::array<std::string_view, 7> kNames = {"street_night", "corridor", "mine",  "room",
+                                                    "tunnel",       "smoke",    "campus"};
 
 }  // namespace
 
@@ -422,10 +496,29 @@ std::span<const std::string_view> scenario_names() { return kNames; }
 
 std::optional<Scenario> make_scenario(std::string_view name, std::uint64_t seed, double duration_s,
                                       double gravity_mps2, std::string& error) {
+  return make_scenario(name, seed, std::nullopt, duration_s, gravity_mps2, error);
+}
+
+std::optional<Scenario> make_scenario(std::string_view name, std::uint64_t seed,
+                                      std::optional<std::uint64_t> drive_seed, double duration_s,
+                                      double gravity_mps2, std::string& error) {
+  if (name == "street_night") {
+    return street_night(seed, drive_seed, duration_s, gravity_mps2);
+  }
+  if (name == "campus") {
+    return campus(seed, drive_seed, duration_s, gravity_mps2);
+  }
+  if (drive_seed && std::find(kNames.begin(), kNames.end(), name) != kNames.end()) {
+    // Their worlds are built around the one drive (a room's furniture around its loop, a
+    // tunnel's walls around its lane): there is nowhere else to drive.
+    error = "scenario '" + std::string(name) +
+            "' has one drive; a drive seed needs a road to drive elsewhere on (campus, "
+            "street_night)";
+    return std::nullopt;
+  }
   if (name == "room") return room(seed, duration_s, gravity_mps2);
   if (name == "corridor") return corridor(seed, duration_s, gravity_mps2);
   if (name == "mine") return mine(seed, duration_s, gravity_mps2);
-  if (name == "street_night") return street_night(seed, duration_s, gravity_mps2);
   if (name == "tunnel") return tunnel(seed, duration_s, gravity_mps2);
   if (name == "smoke") return smoke(seed, duration_s, gravity_mps2);
   error = "unknown scenario '" + std::string(name) + "' (";
