@@ -116,6 +116,12 @@ int run_sim(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--seed", seed, "seed: same seed, same bytes; another, another world")
       ->capture_default_str();
+  std::uint64_t drive_seed_value = 0;
+  CLI::Option* drive_seed_option = app.add_option(
+      "--drive-seed", drive_seed_value,
+      "drive the --seed world again on another path (localisation on a prior map): start, "
+      "direction, line within the road and speeds from this seed; campus and street_night only "
+      "(default: the drive --seed gives)");
   app.add_option("-o,--output", out_path, "recording to write (MCAP)")->required();
   app.add_option(
       "--gt", gt_path,
@@ -191,6 +197,9 @@ int run_sim(int argc, char** argv) {
   options.scenario = scenario;
   options.duration_s = duration_s;
   options.seed = seed;
+  if (drive_seed_option->count() > 0) {
+    options.drive_seed = drive_seed_value;
+  }
   options.lidar = !no_lidar;
   options.visible_camera = options.thermal_camera = !no_cameras;
   options.depth_camera = !no_cameras && (depth || loaded.config.depth_camera.enabled);
@@ -202,7 +211,8 @@ int run_sim(int argc, char** argv) {
   sim::SmokeSchedule smoke;
   {
     std::string e;
-    const auto built = sim::make_scenario(scenario, seed, duration_s, rig.gravity_mps2, e);
+    const auto built =
+        sim::make_scenario(scenario, seed, options.drive_seed, duration_s, rig.gravity_mps2, e);
     if (!built) {
       std::fprintf(stderr, "posectl sim: %s\n", e.c_str());
       return 2;
@@ -230,6 +240,11 @@ int run_sim(int argc, char** argv) {
       {"host_epoch_ns", std::to_string(options.host_epoch_ns)},
       {"gravity_mps2", exact(rig.gravity_mps2)},
       {"noise", options.noise ? "true" : "false"}};
+  if (options.drive_seed) {
+    // Only when given, so a recording without one keeps the bytes it always had.
+    ropt.metadata[std::string(sim::kSimMetadataName)]["drive_seed"] =
+        std::to_string(*options.drive_seed);
+  }
   if (smoke.any()) {
     // When the colour camera's view was degraded, in true time since the start [s]: from the
     // first trace of smoke to the last, and the dense part (smoke.hpp).
@@ -267,8 +282,11 @@ int run_sim(int argc, char** argv) {
       std::fprintf(stderr, "posectl sim: cannot write %s\n", gt_path.c_str());
       return 1;
     }
-    tum << "# posectl sim --scenario " << scenario << " --seed " << seed
-        << ": base_link in map; stamp = wall time [s] (the recording's log time + its "
+    tum << "# posectl sim --scenario " << scenario << " --seed " << seed;
+    if (options.drive_seed) {
+      tum << " --drive-seed " << *options.drive_seed;
+    }
+    tum << ": base_link in map; stamp = wall time [s] (the recording's log time + its "
            "host-to-wall offset, as posed --replay stamps DDS messages)\n";
   }
   RecorderSink sink(recorder, gt_path.empty() ? nullptr : &tum, ropt.host_to_wall);
@@ -301,14 +319,16 @@ int run_sim(int argc, char** argv) {
     return 1;
   }
   const auto counters = recorder.counters();
+  const std::string drive =
+      options.drive_seed ? " drive seed " + std::to_string(*options.drive_seed) : std::string();
   std::printf(
-      "posectl sim: %s seed %llu, %.1f s simulated in %.1f s (%.2fx real time), %llu boxes, "
+      "posectl sim: %s seed %llu%s, %.1f s simulated in %.1f s (%.2fx real time), %llu boxes, "
       "loop %.0f m, driven %.0f m\n"
       "  lidar %llu packets (%llu rays, %.1f %% returns), %llu position packets; imu %llu frames; "
       "visible %llu frames; thermal %llu frames (%s); depth %llu frames; ground truth %llu "
       "poses\n"
       "  %s: %llu messages, %.1f MB%s%s\n",
-      scenario.c_str(), static_cast<unsigned long long>(seed), duration_s, wall,
+      scenario.c_str(), static_cast<unsigned long long>(seed), drive.c_str(), duration_s, wall,
       duration_s / std::max(wall, 1e-9), static_cast<unsigned long long>(summary.boxes),
       summary.path_length_m, summary.distance_m,
       static_cast<unsigned long long>(summary.lidar_packets),

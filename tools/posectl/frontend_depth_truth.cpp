@@ -67,8 +67,13 @@ std::unique_ptr<FrontendDepthTruth> FrontendDepthTruth::for_recording(
     why = "the " + std::string(sim::kSimMetadataName) + " record is incomplete";
     return nullptr;
   }
+  // Another drive through the seed's world when the recording names one.
+  std::optional<std::uint64_t> drive_seed;
+  if (double d = 0; parse(*entries, "drive_seed", d)) {
+    drive_seed = static_cast<std::uint64_t>(d);
+  }
   std::optional<sim::Scenario> built = sim::make_scenario(
-      scenario->second, static_cast<std::uint64_t>(seed), duration_s, gravity, why);
+      scenario->second, static_cast<std::uint64_t>(seed), drive_seed, duration_s, gravity, why);
   if (!built) return nullptr;
   auto truth = std::unique_ptr<FrontendDepthTruth>(new FrontendDepthTruth());
   truth->world_ = std::make_unique<World>();

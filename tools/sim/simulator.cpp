@@ -132,7 +132,8 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
     return false;
   }
   std::optional<Scenario> scenario =
-      make_scenario(options.scenario, options.seed, options.duration_s, rig.gravity_mps2, error);
+      make_scenario(options.scenario, options.seed, options.drive_seed, options.duration_s,
+                    rig.gravity_mps2, error);
   if (!scenario) return false;
   const Trajectory& trajectory = scenario->trajectory;
   const Bvh bvh(scenario->world);
@@ -220,7 +221,10 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
   }
 
   // Streams, named as the daemon's Sources name them (raw_channels.hpp).
-  const std::string scen = "sim " + options.scenario + " seed " + std::to_string(options.seed);
+  std::string scen = "sim " + options.scenario + " seed " + std::to_string(options.seed);
+  if (options.drive_seed) {
+    scen += " drive seed " + std::to_string(*options.drive_seed);
+  }
   int s_imu = -1, s_lidar = -1, s_pos = -1, s_vis = -1, s_vis_meta = -1, s_th = -1;
   int s_depth = -1, s_depth_meta = -1, s_rs_accel = -1, s_rs_gyro = -1;
   bool refused = false;

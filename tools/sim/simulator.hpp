@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -71,6 +72,8 @@ struct SimOptions {
   /// simulated time [s]
   double duration_s = 10.0;
   std::uint64_t seed = 1;
+  /// another drive through the seed's world (make_scenario(); campus and street_night only)
+  std::optional<std::uint64_t> drive_seed;
   bool lidar = true;
   bool imu = true;
   bool visible_camera = true;
@@ -118,10 +121,10 @@ bool run_simulation(const SimRig& rig, const SimOptions& options, SimSink& sink,
 /// The wall time the simulated recording claims to start at: 2024-06-01T12:00:00Z [ns].
 inline constexpr std::int64_t kSimWallStartNs = 1'717'243'200'000'000'000;
 /// The Metadata record `posectl sim` writes: scenario, seed, duration_s, host_epoch_ns,
-/// gravity_mps2, noise (make_scenario() rebuilds the world and drive from them); with smoke
-/// (the `smoke` scenario) also visible_degraded_from_s, visible_degraded_to_s,
-/// smoke_dense_from_s, smoke_dense_to_s [s, true time since the start] and
-/// smoke_extinction_per_m (docs/simulator.md).
+/// gravity_mps2, noise, and drive_seed when one was given (make_scenario() rebuilds the world
+/// and drive from them); with smoke (the `smoke` scenario) also visible_degraded_from_s,
+/// visible_degraded_to_s, smoke_dense_from_s, smoke_dense_to_s [s, true time since the start]
+/// and smoke_extinction_per_m (docs/simulator.md).
 inline constexpr std::string_view kSimMetadataName = "posed.sim";
 
 }  // namespace posed::sim

@@ -394,6 +394,26 @@ TEST(Campus, ADriveSeedDrivesTheSameWorldElsewhereOnTheRoad) {
   }
 }
 
+TEST(Campus, TheSimulatorDrivesTheDriveSeedsDrive) {
+  const SimRig rig = rig_from_config(config::default_config());
+  const auto run = [&](std::optional<std::uint64_t> drive_seed) {
+    SimOptions o;
+    o.scenario = "campus";
+    o.duration_s = 0.3;
+    o.seed = 31;
+    o.drive_seed = drive_seed;
+    o.visible_camera = o.thermal_camera = false;
+    HashSink sink;
+    SimSummary summary;
+    std::string error;
+    EXPECT_TRUE(run_simulation(rig, o, sink, summary, error)) << error;
+    return sink.hash();
+  };
+  // (A drive seed equal to the seed drives the same drive, but the streams' metadata name it.)
+  EXPECT_NE(run(std::nullopt), run(7));
+  EXPECT_EQ(run(7), run(7));
+}
+
 TEST(Scenarios, ADriveSeedNeedsARoadToDriveElsewhereOn) {
   for (const char* name : {"room", "corridor", "mine", "tunnel", "smoke"}) {
     std::string error;
