@@ -44,12 +44,17 @@ void print_mapping_summary(const pipeline::MappingFigures& m) {
       refused(mapping::RegistrationVerdict::kLowOverlap),
       refused(mapping::RegistrationVerdict::kDiverged),
       static_cast<unsigned long long>(f.unconfirmed));
+  const std::uint64_t registrations = f.distance_candidates + f.descriptor_candidates;
   std::printf(
-      "                      map -> odom %.3f m, %.2f deg; registration %.1f s in all, last "
-      "optimisation %.3f s; keyframe clouds %.1f M points%s\n",
+      "                      candidates %llu by distance, %llu by descriptor, registered in "
+      "%.1f ms on average; map -> odom %.3f m, %.2f deg; last optimisation %.3f s; keyframe "
+      "clouds %.1f M points%s\n",
+      static_cast<unsigned long long>(f.distance_candidates),
+      static_cast<unsigned long long>(f.descriptor_candidates),
+      registrations > 0 ? 1e3 * f.registration_time_s / static_cast<double>(registrations) : 0.0,
       m.T_map_odom.translation().norm(),
-      Eigen::AngleAxisd(m.T_map_odom.rotation()).angle() * 180.0 / M_PI, f.registration_time_s,
-      f.last_optimisation_s, static_cast<double>(f.stored_points) / 1e6,
+      Eigen::AngleAxisd(m.T_map_odom.rotation()).angle() * 180.0 / M_PI, f.last_optimisation_s,
+      static_cast<double>(f.stored_points) / 1e6,
       m.keyframes_dropped > 0 ? " (some keyframes dropped: the mapping thread fell behind)" : "");
 }
 

@@ -78,7 +78,7 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
   }
   keyframes_.push_back(std::move(kf));
   figures_.keyframes = keyframes_.size();
-  if (config_.attempt_every_keyframes > 0 &&
+  if (config_.attempt_every_keyframes > 0 && index >= next_attempt_ &&
       index % static_cast<std::size_t>(config_.attempt_every_keyframes) == 0) {
     try_loop(index);
   }
@@ -233,6 +233,8 @@ void LoopCloser::try_loop(std::size_t query) {
 
 void LoopCloser::accept(const PoseGraphEdge& edge, const LoopRecord& record) {
   graph_.add_edge(edge);
+  next_attempt_ =
+      keyframes_.size() + static_cast<std::size_t>(std::max(0, config_.cooldown_keyframes));
   loops_.push_back(record);
   figures_.loops = loops_.size();
   const PoseGraphSolve solve = graph_.optimise();

@@ -36,10 +36,14 @@ struct LoopClosureConfig {
   double keyframe_max_range_m = 60.0;  ///< points farther are not kept [m]
   /// loops are looked for at every n-th keyframe: registration is the expensive part [1]
   int attempt_every_keyframes = 2;
+  /// after a loop is accepted, none is looked for over this many keyframes: a revisit would
+  /// otherwise close one every attempt, each a registration and an optimisation that move the
+  /// map by millimetres [1]
+  int cooldown_keyframes = 10;
   /// a candidate must be at least this much older than the query: a loop, not a neighbour [s]
   double min_separation_s = 30.0;
   double search_radius_m = 8.0;  ///< distance candidates: within this of the estimate [m]
-  int submap_keyframes = 8;      ///< keyframes either side of the candidate in its submap [1]
+  int submap_keyframes = 5;      ///< keyframes either side of the candidate in its submap [1]
   ScanContextConfig scan_context;
   double scan_context_max_distance = 0.25;  ///< descriptor candidates: at most this distance
   int ring_key_candidates = 8;              ///< nearest ring keys compared in full [1]
@@ -149,6 +153,7 @@ class LoopCloser {
   PoseGraph graph_;
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
   std::optional<Pending> pending_;
+  std::size_t next_attempt_ = 0;  ///< no attempt before this keyframe index (cooldown)
   LoopClosureFigures figures_;
   std::vector<LoopRecord> loops_;
 };

@@ -19,7 +19,7 @@
 namespace posed::mapping {
 
 struct RegistrationConfig {
-  double voxel_m = 0.4;               ///< both clouds are thinned to one point per voxel [m]
+  double voxel_m = 0.5;               ///< both clouds are thinned to one point per voxel [m]
   double max_correspondence_m = 2.0;  ///< GICP pairs no points farther apart [m]
   int max_iterations = 40;            ///< GICP iterations [1]
   /// after alignment: a query point with a target point this near is an inlier [m]; thinned
