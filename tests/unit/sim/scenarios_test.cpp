@@ -321,6 +321,7 @@ TEST(Campus, TenMinutesGoRoundTheLoopMoreThanTwiceAndCrossIt) {
     }
     EXPECT_GT(driven, 1000.0) << "seed " << seed;
     EXPECT_LT(driven, 2400.0) << "seed " << seed;
+    EXPECT_GT(driven, 2 * s->trajectory.path().length()) << "seed " << seed;
     // A place passed again more than 60 s later; and one passed again from another direction
     // (40° or more apart: where the figure of eight crosses itself).
     bool revisit = false, crossing = false;
@@ -344,9 +345,10 @@ TEST(Campus, TenMinutesGoRoundTheLoopMoreThanTwiceAndCrossIt) {
 }
 
 TEST(Campus, HasAnOpenStretchAndBuildingsAlongMostOfTheLoop) {
-  // Over 600 s: the longest stretch driven with nothing taller than 1 m (the kerbs and bollards
-  // are lower) within 25 m, and the share of the distance driven with a building (taller than
-  // 3.5 m, larger than 60 m² on the ground) within 30 m. (Seeds 1, 2, 31: 102-137 m, 73-82 %.)
+  // Over 600 s: the longest stretch driven with nothing taller than 30 cm (paint, grass, the
+  // kerbs elsewhere) within 60 m, and the share of the distance driven with a building (taller
+  // than 3.5 m, larger than 60 m² on the ground) within 30 m. (Seeds 1, 2, 31: 153-167 m,
+  // 66-75 %; seeds 1-25 with their drive seeds: 148-187 m, 52-76 %.)
   for (const std::uint64_t seed : {1, 2, 31}) {
     std::string error;
     const auto s = make_scenario("campus", seed, 600.0, 9.805, error);
@@ -355,24 +357,24 @@ TEST(Campus, HasAnOpenStretchAndBuildingsAlongMostOfTheLoop) {
     double run = 0, longest = 0, near_buildings = 0, driven = 0;
     for (std::size_t i = 0; i < t.p.size(); ++i) {
       const double tall =
-          nearest_m(s->world, t.p[i], [](const Box& b) { return obstacle(b) && top_m(b) > 1.0; });
+          nearest_m(s->world, t.p[i], [](const Box& b) { return obstacle(b) && top_m(b) > 0.3; });
       const double building = nearest_m(s->world, t.p[i], [](const Box& b) {
         return obstacle(b) && top_m(b) > 3.5 && 4 * b.half_extent_m.x() * b.half_extent_m.y() > 60;
       });
-      run = tall > 25.0 ? run + step_m(t, i) : 0.0;
+      run = tall > 60.0 ? run + step_m(t, i) : 0.0;
       longest = std::max(longest, run);
       driven += step_m(t, i);
       near_buildings += building < 30.0 ? step_m(t, i) : 0.0;
     }
     EXPECT_GT(longest, 80.0) << "seed " << seed;
-    EXPECT_GT(near_buildings / driven, 0.6) << "seed " << seed;
+    EXPECT_GT(near_buildings / driven, 0.55) << "seed " << seed;
   }
 }
 
 TEST(Campus, ADriveSeedDrivesTheSameWorldElsewhereOnTheRoad) {
   // campus keeps 1.5 m from the kerbs; street_night 1 m from its parked cars (the nearest of
   // its things, 1.6 m from the centre line on the inside of bends). (Seed 31, drive seeds 1-4:
-  // 1.6-2.8 m and 1.6-1.8 m.)
+  // 1.6-2.7 m and 1.6-1.8 m.)
   for (const auto& [name, clearance_m] :
        {std::pair{"campus", 1.2}, std::pair{"street_night", 0.9}}) {
     std::string error;
