@@ -380,6 +380,16 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     if (recorder) pipeline::tap_sources(built.sources, *recorder, config);
     sinks.new_pass();
   }
+  // The loop-closed trajectory as it stands at the end (the last pass's): every keyframe's
+  // optimised pose, for evaluating the map rather than the poses as they went out.
+  if (recorder && pipe) {
+    for (const auto& [stamp, T] : pipe->optimised_keyframes()) {
+      const Eigen::Quaterniond q(T.rotation());
+      const Eigen::Vector3d& p = T.translation();
+      recorder->write_pose("/posed/keyframes", to_wall(stamp), config.dds.map_frame,
+                           {p.x(), p.y(), p.z()}, {q.x(), q.y(), q.z(), q.w()});
+    }
+  }
   extra.stop();  // the last clouds and images reach the recording too
   if (recorder && !recorder->close()) {
     POSED_LOG_ERROR("recording %s: %s", options.record_path.c_str(), recorder->error().c_str());

@@ -133,6 +133,15 @@ Eigen::Isometry3d MappingStage::T_map_odom(std::uint64_t scans_before) const {
   return Eigen::Isometry3d::Identity();
 }
 
+std::vector<std::pair<HostTime, Eigen::Isometry3d>> MappingStage::optimised_keyframes() const {
+  std::vector<std::pair<HostTime, Eigen::Isometry3d>> out;
+  out.reserve(closer_.keyframe_count());
+  for (std::size_t i = 0; i < closer_.keyframe_count(); ++i) {
+    out.emplace_back(closer_.keyframe_stamp(i), closer_.T_map_keyframe(i));
+  }
+  return out;
+}
+
 MappingFigures MappingStage::figures() const {
   std::lock_guard lock(mutex_);
   return figures_;

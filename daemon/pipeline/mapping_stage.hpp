@@ -55,6 +55,9 @@ class MappingStage final : public ScanObserver {
   /// the newest.
   Eigen::Isometry3d T_map_odom(std::uint64_t scans_before) const;
   MappingFigures figures() const;
+  /// Every keyframe's stamp and optimised pose (base_link in map), oldest first. After the
+  /// stage's thread has ended.
+  std::vector<std::pair<HostTime, Eigen::Isometry3d>> optimised_keyframes() const;
 
  private:
   struct Item {

@@ -319,6 +319,11 @@ std::optional<MappingFigures> Pipeline::mapping_figures() const {
   return mapping_stage_->figures();
 }
 
+std::vector<std::pair<HostTime, Eigen::Isometry3d>> Pipeline::optimised_keyframes() const {
+  if (!mapping_stage_) return {};
+  return mapping_stage_->optimised_keyframes();
+}
+
 std::vector<CameraFigures> Pipeline::camera_compare_figures() const {
   return camera_core_ ? camera_core_->cameras().compare_figures() : std::vector<CameraFigures>{};
 }

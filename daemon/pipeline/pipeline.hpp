@@ -158,6 +158,8 @@ class Pipeline {
   void export_map(MapExport& out) const;
   /// The mapping stage's loops and map -> odom (safe from any thread; nullopt without one).
   std::optional<MappingFigures> mapping_figures() const;
+  /// The mapping stage's keyframes, optimised (call after join(); empty without one).
+  std::vector<std::pair<HostTime, Eigen::Isometry3d>> optimised_keyframes() const;
   /// The comparison front ends' figures (call after join(); empty without them).
   std::vector<CameraFigures> camera_compare_figures() const;
 

@@ -73,6 +73,18 @@ TEST(LoopClosureReplay, ARoomsLapsCloseLoopsIdenticallyOnEveryReplayAndLeaveOdom
   }
   EXPECT_GT(moved, 0u) << "the loops moved no pose into another map frame";
 
+  // The optimised keyframes go into the recording at the end, the same on both replays.
+  const auto keyframes_a = recorded_poses(dir.file("a.mcap"), "/posed/keyframes", false);
+  const auto keyframes_b = recorded_poses(dir.file("b.mcap"), "/posed/keyframes", false);
+  EXPECT_GT(keyframes_a.size(), 20u);
+  ASSERT_EQ(keyframes_a.size(), keyframes_b.size());
+  for (auto ia = keyframes_a.begin(), ib = keyframes_b.begin(); ia != keyframes_a.end();
+       ++ia, ++ib) {
+    ASSERT_EQ(ia->first, ib->first);
+    ASSERT_EQ(ia->second.p_xyz_m, ib->second.p_xyz_m);
+  }
+  EXPECT_TRUE(recorded_poses(dir.file("off.mcap"), "/posed/keyframes", false).empty());
+
   // Odometry is the estimator's alone: bit-identical with and without the mapping stage.
   const auto odom_a = recorded_poses(dir.file("a.mcap"), "/posed/odom", true);
   const auto odom_off = recorded_poses(dir.file("off.mcap"), "/posed/odom", true);
