@@ -84,15 +84,22 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
   }
 }
 
-std::optional<LoopCloser::Candidate> LoopCloser::distance_candidate(std::size_t query) const {
+std::size_t LoopCloser::old_enough(std::size_t query) const {
+  std::size_t n = 0;
+  // Stamps rise with the index: the first keyframe too recent ends the old enough ones.
+  while (n < query && seconds_between(keyframes_[n].stamp, keyframes_[query].stamp) >=
+                          config_.min_separation_s) {
+    ++n;
+  }
+  return n;
+}
+
+std::optional<LoopCloser::Candidate> LoopCloser::distance_candidate(std::size_t query,
+                                                                    std::size_t eligible) const {
   const Eigen::Isometry3d T_map_query = graph_.node(query);
-  const HostTime newest_allowed = keyframes_[query].stamp;
   std::optional<Candidate> best;
   double best_distance = config_.search_radius_m;
-  for (std::size_t i = 0; i < query; ++i) {
-    if (seconds_between(keyframes_[i].stamp, newest_allowed) < config_.min_separation_s) {
-      break;  // stamps rise with the index: the rest are too recent
-    }
+  for (std::size_t i = 0; i < eligible; ++i) {
     const Eigen::Isometry3d T_map_i = graph_.node(i);
     const double d = (T_map_i.translation() - T_map_query.translation()).norm();
     if (d < best_distance) {
@@ -103,15 +110,13 @@ std::optional<LoopCloser::Candidate> LoopCloser::distance_candidate(std::size_t 
   return best;
 }
 
-std::optional<LoopCloser::Candidate> LoopCloser::descriptor_candidate(std::size_t query) const {
+std::optional<LoopCloser::Candidate> LoopCloser::descriptor_candidate(std::size_t query,
+                                                                      std::size_t eligible) const {
   const Keyframe& q = keyframes_[query];
   // Nearest ring keys (heading-invariant) among the keyframes old enough, then Scan Context
   // distances over those few.
   std::vector<std::pair<float, std::size_t>> by_ring_key;
-  for (std::size_t i = 0; i < query; ++i) {
-    if (seconds_between(keyframes_[i].stamp, q.stamp) < config_.min_separation_s) {
-      break;
-    }
+  for (std::size_t i = 0; i < eligible; ++i) {
     by_ring_key.emplace_back((keyframes_[i].context.ring_key - q.context.ring_key).squaredNorm(),
                              i);
   }
@@ -157,24 +162,20 @@ std::vector<Eigen::Vector3f> LoopCloser::submap(std::size_t centre,
 
 void LoopCloser::try_loop(std::size_t query) {
   ++figures_.attempts;
-  std::optional<Candidate> candidate = distance_candidate(query);
+  const std::size_t eligible = old_enough(query);
+  std::optional<Candidate> candidate = distance_candidate(query, eligible);
   if (candidate) {
     ++figures_.distance_candidates;
   } else {
-    candidate = descriptor_candidate(query);
+    candidate = descriptor_candidate(query, eligible);
     if (!candidate) {
       return;
     }
     ++figures_.descriptor_candidates;
   }
   // The submap holds only keyframes old enough to be a loop, never the query's own neighbours.
-  std::size_t newest_allowed = candidate->index;
-  while (newest_allowed + 1 < query &&
-         seconds_between(keyframes_[newest_allowed + 1].stamp, keyframes_[query].stamp) >=
-             config_.min_separation_s) {
-    ++newest_allowed;
-  }
-  const std::vector<Eigen::Vector3f> target = submap(candidate->index, newest_allowed);
+  // (Every candidate is one of them, so there is at least one.)
+  const std::vector<Eigen::Vector3f> target = submap(candidate->index, eligible - 1);
   const auto started = std::chrono::steady_clock::now();
   const RegistrationResult reg =
       register_clouds(keyframes_[query].points_base, target, candidate->T_candidate_query_guess,

@@ -141,8 +141,12 @@ class LoopCloser {
   };
 
   void try_loop(std::size_t query);
-  std::optional<Candidate> distance_candidate(std::size_t query) const;
-  std::optional<Candidate> descriptor_candidate(std::size_t query) const;
+  /// How many keyframes, from the first, are at least min_separation_s older than `query`: the
+  /// ones a loop may join.
+  std::size_t old_enough(std::size_t query) const;
+  /// `eligible`: old_enough(query).
+  std::optional<Candidate> distance_candidate(std::size_t query, std::size_t eligible) const;
+  std::optional<Candidate> descriptor_candidate(std::size_t query, std::size_t eligible) const;
   std::vector<Eigen::Vector3f> submap(std::size_t centre, std::size_t newest_allowed) const;
   void accept(const PoseGraphEdge& edge, const LoopRecord& record);
   void update_correction();
