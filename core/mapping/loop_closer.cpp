@@ -5,18 +5,10 @@
 #include <cmath>
 #include <limits>
 
-#include "core/math/so3.hpp"
+#include "core/mapping/place_recognition.hpp"
 
 namespace posed::mapping {
 namespace {
-
-/// The rotation that removes `R`'s roll and pitch and keeps its yaw out too: a levelled frame
-/// whose x is the body's heading projected onto the horizontal. R_level_base = Rz(yaw)^T R.
-Eigen::Matrix3d levelling(const Eigen::Matrix3d& R_odom_base) {
-  const Eigen::Vector3d heading = R_odom_base.col(0);
-  const double yaw = std::atan2(heading.y(), heading.x());
-  return Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_odom_base;
-}
 
 double angle_of(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 
@@ -39,26 +31,15 @@ bool LoopCloser::add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
 
 void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
                               std::span<const Eigen::Vector3f> points_base) {
+  DescribedScan described =
+      describe_scan(points_base, T_odom_base.rotation(), config_.keyframe_max_range_m,
+                    config_.keyframe_voxel_m, config_.scan_context);
   Keyframe kf;
   kf.stamp = stamp;
   kf.T_odom_base = T_odom_base;
-  kf.R_level_base = levelling(T_odom_base.rotation());
-  std::vector<Eigen::Vector3f> in_range;
-  std::vector<Eigen::Vector3f> level;
-  in_range.reserve(points_base.size());
-  level.reserve(points_base.size());
-  const Eigen::Matrix3f R_level_base = kf.R_level_base.cast<float>();
-  const auto max_range2 =
-      static_cast<float>(config_.keyframe_max_range_m * config_.keyframe_max_range_m);
-  for (const Eigen::Vector3f& p : points_base) {
-    if (!p.allFinite() || p.squaredNorm() > max_range2) {
-      continue;
-    }
-    in_range.push_back(p);
-    level.push_back(R_level_base * p);
-  }
-  kf.context = make_scan_context(level, config_.scan_context);
-  kf.points_base = thin_cloud(in_range, config_.keyframe_voxel_m);
+  kf.R_level_base = described.R_level_base;
+  kf.points_base = std::move(described.points_base);
+  kf.context = std::move(described.context);
   figures_.stored_points += kf.points_base.size();
 
   // A new node where the current correction puts it, tied to the one before by the odometry.
@@ -113,35 +94,15 @@ std::optional<LoopCloser::Candidate> LoopCloser::distance_candidate(std::size_t 
 std::optional<LoopCloser::Candidate> LoopCloser::descriptor_candidate(std::size_t query,
                                                                       std::size_t eligible) const {
   const Keyframe& q = keyframes_[query];
-  // Nearest ring keys (heading-invariant) among the keyframes old enough, then Scan Context
-  // distances over those few.
-  std::vector<std::pair<float, std::size_t>> by_ring_key;
-  for (std::size_t i = 0; i < eligible; ++i) {
-    by_ring_key.emplace_back((keyframes_[i].context.ring_key - q.context.ring_key).squaredNorm(),
-                             i);
+  const std::optional<DescriptorMatch> match = best_descriptor_match(
+      q.context, q.R_level_base, eligible,
+      [this](std::size_t i) -> const ScanContext& { return keyframes_[i].context; },
+      [this](std::size_t i) -> const Eigen::Matrix3d& { return keyframes_[i].R_level_base; },
+      config_.ring_key_candidates, config_.scan_context_max_distance, config_.scan_context);
+  if (!match) {
+    return std::nullopt;
   }
-  const auto n = std::min<std::size_t>(by_ring_key.size(),
-                                       static_cast<std::size_t>(config_.ring_key_candidates));
-  std::partial_sort(by_ring_key.begin(), by_ring_key.begin() + static_cast<std::ptrdiff_t>(n),
-                    by_ring_key.end());
-  std::optional<Candidate> best;
-  double best_distance = config_.scan_context_max_distance;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = by_ring_key[k].second;
-    const ScanContextMatch match =
-        match_scan_contexts(q.context, keyframes_[i].context, config_.scan_context);
-    if (match.distance < best_distance) {
-      best_distance = match.distance;
-      // In the levelled frames the query sits at the candidate turned by the match's yaw; the
-      // places are the same, so no translation.
-      const Eigen::Matrix3d R_level_c_level_q =
-          Eigen::AngleAxisd(match.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
-      guess.linear() = keyframes_[i].R_level_base.transpose() * R_level_c_level_q * q.R_level_base;
-      best = Candidate{i, true, guess};
-    }
-  }
-  return best;
+  return Candidate{match->index, true, match->T_match_query_guess};
 }
 
 std::vector<Eigen::Vector3f> LoopCloser::submap(std::size_t centre,
@@ -242,6 +203,19 @@ void LoopCloser::accept(const PoseGraphEdge& edge, const LoopRecord& record) {
   ++figures_.optimisations;
   figures_.last_optimisation_s = solve.solve_time_s;
   update_correction();
+}
+
+KeyframeMap LoopCloser::snapshot() const {
+  KeyframeMap map;
+  map.voxel_m = config_.keyframe_voxel_m;
+  map.scan_context = config_.scan_context;
+  map.keyframes.reserve(keyframes_.size());
+  for (std::size_t i = 0; i < keyframes_.size(); ++i) {
+    const Keyframe& kf = keyframes_[i];
+    map.keyframes.push_back({kf.stamp.ns, graph_.node(i), kf.points_base, kf.context});
+  }
+  map.edges = graph_.edges();
+  return map;
 }
 
 void LoopCloser::update_correction() {

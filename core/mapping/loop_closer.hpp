@@ -21,6 +21,7 @@
 #include <span>
 #include <vector>
 
+#include "core/mapping/keyframe_map.hpp"
 #include "core/mapping/keyframe_selector.hpp"
 #include "core/mapping/pose_graph.hpp"
 #include "core/mapping/registration.hpp"
@@ -119,6 +120,9 @@ class LoopCloser {
   const LoopClosureFigures& figures() const { return figures_; }
   const std::vector<LoopRecord>& loops() const { return loops_; }
   const PoseGraph& graph() const { return graph_; }
+  /// The map as it stands: every keyframe at its optimised pose, with its cloud and descriptor,
+  /// and the graph's edges (stamp_ns: the keyframes' HostTime; a writer may restamp them).
+  KeyframeMap snapshot() const;
 
  private:
   struct Keyframe {

@@ -5,11 +5,9 @@
 #include <cstring>
 
 namespace posed::drivers::recording {
-namespace {
 
-/// Writes `body` to `path` through `path.tmp` and a rename.
-template <class Body>
-bool write_atomically(const std::string& path, std::string& error, Body body) {
+bool write_atomically(const std::string& path, std::string& error,
+                      const std::function<bool(std::FILE*)>& body) {
   const std::string tmp = path + ".tmp";
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (f == nullptr) {
@@ -30,8 +28,6 @@ bool write_atomically(const std::string& path, std::string& error, Body body) {
   }
   return true;
 }
-
-}  // namespace
 
 std::string tum_line(std::int64_t stamp_ns, const Eigen::Vector3d& p_m,
                      const Eigen::Quaterniond& q) {

@@ -9,6 +9,8 @@
 // half-written file under the final name.
 
 #include <Eigen/Geometry>
+#include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,11 @@ struct StampedTransform {
   WallTime stamp;
   Eigen::Isometry3d T;
 };
+
+/// Writes `path` through `path.tmp` and a rename: `body` writes the content and says whether it
+/// succeeded. False with `error` naming the file and the failing step.
+bool write_atomically(const std::string& path, std::string& error,
+                      const std::function<bool(std::FILE*)>& body);
 
 /// One TUM line (with '\n') for a pose at `stamp_ns`.
 std::string tum_line(std::int64_t stamp_ns, const Eigen::Vector3d& p_m,

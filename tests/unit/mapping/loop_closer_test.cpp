@@ -5,8 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/lidar/scan_motion.hpp"
-#include "tests/unit/lidar/sim_fixture.hpp"
+#include "tests/unit/mapping/deskewed_scan.hpp"
 #include "tests/unit/mapping/synthetic_scene.hpp"
 
 namespace posed::mapping {
@@ -38,16 +37,9 @@ struct Replayed {
 /// Feeds every scan of `run`, deskewed with the true motion and put in base_link, to `closer`
 /// with `odometry`'s poses.
 Replayed replay(const sim::LidarImuRun& run, const DriftingOdometry& odometry, LoopCloser& closer) {
-  std::vector<lidar::ScanPoint> deskewed;
   std::vector<Eigen::Vector3f> points_base;
-  const Eigen::Isometry3f T_base_lidar = run.rig.T_imu_lidar.cast<float>();
   for (const sim::DecodedScan& scan : run.scans) {
-    lidar::deskew(scan.points, scan.start, test::true_motion(run, scan), 1800, 0.5f, 100.f,
-                  deskewed);
-    points_base.clear();
-    for (const lidar::ScanPoint& p : deskewed) {
-      points_base.push_back(T_base_lidar * p.p);
-    }
+    test::deskewed_base(run, scan, points_base);
     closer.add(scan.end, odometry.T_odom_base(run, scan.end), points_base);
   }
   Replayed out;
