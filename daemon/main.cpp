@@ -50,10 +50,21 @@ int main(int argc, char** argv) noexcept try {
                  "Foxglove opens: comma-separated from tf, tf_static, path, diagnostics, status, "
                  "cloud, map, image; all; or none (a cloud is ~1.2 MB a scan)")
       ->capture_default_str();
-  app.add_option("--save-map", options.map_path,
-                 "at the end of the run (or on SIGTERM), write the lidar map to this PCD file "
-                 "(binary, x y z in the map frame [m]) and the keyframe poses to "
-                 "FILE.keyframes.tum");
+  std::string save_map_path;
+  auto* save_map =
+      app.add_option("--save-map", save_map_path,
+                     "at the end of the run (or on SIGTERM): a path ending in .pcd gets the "
+                     "estimator's lidar map (binary PCD, x y z in the odometry frame [m]) and the "
+                     "keyframe poses in FILE.keyframes.tum; any other path is a directory that "
+                     "gets the loop-closed keyframe map (map.pcd, keyframes.tum, edges.txt, "
+                     "scan_contexts.bin, map.yaml; docs/mapping.md) that --map loads");
+  app.add_option("--map", options.prior_map_dir,
+                 "localise on the keyframe map in this directory (written by --save-map DIR): "
+                 "find the place by descriptor or from mapping.initial_* / rt/initialpose, then "
+                 "track the map; rt/posed/pose and map -> odom are in the map's frame, and the "
+                 "map is not grown")
+      ->check(CLI::ExistingDirectory)
+      ->excludes(save_map);
   auto* replay = app.add_option("--replay", options.replay.path,
                                 "replay this MCAP recording through the same pipeline instead of "
                                 "opening the sensors")
@@ -108,6 +119,10 @@ int main(int argc, char** argv) noexcept try {
   }
   if (max_speed) options.replay.rate = 0;
   options.replay.duration_s = options.duration_s;
+  if (!save_map_path.empty()) {
+    (posed::is_map_directory_path(save_map_path) ? options.map_dir : options.map_path) =
+        save_map_path;
+  }
 
   if (version) {
     std::printf("%.*s\n", static_cast<int>(posed::version_string().size()),

@@ -98,6 +98,9 @@ class PoseSinks {
             drivers::recording::Recorder* recorder, HostToWall to_wall, HostTime started,
             bool live_clock);
 
+  /// The clock conversion every stamp it publishes went through.
+  const HostToWall& to_wall() const { return to_wall_; }
+
   /// IMU-rate odometry: rt/posed/odom (every publish.odom_decimation-th) and /posed/odom. From
   /// one thread at a time.
   void odom(const NavState& s);

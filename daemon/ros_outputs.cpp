@@ -109,6 +109,26 @@ dds::DiagnosticsMessage diagnostics(const pipeline::PipelineStatus& st, WallTime
               {"scans degenerate", std::to_string(f.scans_degenerate)},
               {"reinitialisations", std::to_string(f.reinitialisations)}};
   msg.status.push_back(std::move(e));
+  if (st.mapping) {
+    const pipeline::MappingStatus& m = *st.mapping;
+    dds::DiagnosticStatusMessage d;
+    d.name = "posed: mapping";
+    d.hardware_id = "mapping stage";
+    // Localising and not localised: poses are not in the prior map's frame yet (or any more).
+    d.level = m.localising && m.state != "localised" ? dds::DiagnosticStatusMessage::kWarn
+                                                     : dds::DiagnosticStatusMessage::kOk;
+    d.message = m.state;
+    d.values = {{"state", m.state},
+                {"map -> odom", number(m.correction_m, "m")},
+                {"scans skipped", std::to_string(m.scans_skipped)}};
+    if (m.localising) {
+      d.values.push_back({"fixes", std::to_string(m.fixes)});
+    } else {
+      d.values.push_back({"keyframes", std::to_string(m.keyframes)});
+      d.values.push_back({"loops", std::to_string(m.loops)});
+    }
+    msg.status.push_back(std::move(d));
+  }
   return msg;
 }
 

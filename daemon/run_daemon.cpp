@@ -31,6 +31,7 @@
 #include "drivers/camera/libusb_transport.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "drivers/common/log.hpp"
+#include "drivers/recording/map_directory.hpp"
 #include "drivers/recording/map_files.hpp"
 #include "drivers/recording/mcap_replay_source.hpp"
 #include "drivers/recording/recorder.hpp"
@@ -76,6 +77,54 @@ bool save_map(const pipeline::Pipeline& pipe, const std::string& map_path, HostT
   return true;
 }
 
+/// Writes the mapping stage's keyframe map to `dir` (--save-map DIR).
+bool save_map_directory(const pipeline::Pipeline& pipe, const std::string& dir, HostToWall to_wall,
+                        std::string& line) {
+  mapping::KeyframeMap map = pipe.built_map();
+  if (map.keyframes.empty()) {
+    line =
+        "none (the mapping stage kept no keyframe: mapping.loop_closure off, no lidar scan "
+        "matched, or localising on a prior map, which is not grown)";
+    POSED_LOG_ERROR("--save-map %s: %s", dir.c_str(), line.c_str());
+    return false;
+  }
+  // Keyframes carry the wall clock on disk, as poses and TUM files do.
+  for (mapping::MapKeyframe& kf : map.keyframes) kf.stamp_ns = to_wall(HostTime{kf.stamp_ns}).ns;
+  std::string error;
+  if (!drivers::recording::write_map_directory(dir, map, error)) {
+    POSED_LOG_ERROR("--save-map: %s", error.c_str());
+    line = "failed: " + error;
+    return false;
+  }
+  std::size_t points = 0, loops = 0;
+  for (const mapping::MapKeyframe& kf : map.keyframes) points += kf.points_base.size();
+  for (const mapping::PoseGraphEdge& e : map.edges) loops += e.loop ? 1 : 0;
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%zu keyframes, %zu points (%.2f m voxels), %zu loop edges to %s/",
+                map.keyframes.size(), points, map.voxel_m, loops, dir.c_str());
+  line = buf;
+  return true;
+}
+
+/// Loads --map DIR; null (logged) when it cannot.
+std::shared_ptr<const mapping::KeyframeMap> load_prior_map(const std::string& dir) {
+  auto map = std::make_shared<mapping::KeyframeMap>();
+  std::string error;
+  if (!drivers::recording::read_map_directory(dir, *map, error)) {
+    POSED_LOG_ERROR("--map %s: %s", dir.c_str(), error.c_str());
+    return nullptr;
+  }
+  if (map->keyframes.empty()) {
+    POSED_LOG_ERROR("--map %s: the map has no keyframes", dir.c_str());
+    return nullptr;
+  }
+  std::size_t points = 0;
+  for (const mapping::MapKeyframe& kf : map->keyframes) points += kf.points_base.size();
+  POSED_LOG_INFO("localising on %s: %zu keyframes, %zu points", dir.c_str(), map->keyframes.size(),
+                 points);
+  return map;
+}
+
 /// How far the next --loop pass is shifted past the start of the last one: the span every
 /// stream together delivered, plus the IMU's last sample interval, so the stamps go on as if the
 /// recording continued. Nullopt when the pass delivered nothing.
@@ -116,6 +165,12 @@ void log_pass(std::uint64_t pass, const pipeline::Pipeline& pipe, const PoseSink
 }
 
 }  // namespace
+
+bool is_map_directory_path(const std::string& map_path) {
+  const std::string ext = ".pcd";
+  return !(map_path.size() > ext.size() &&
+           map_path.compare(map_path.size() - ext.size(), ext.size(), ext) == 0);
+}
 
 std::string keyframes_path_for(const std::string& map_path) {
   const std::string ext = ".pcd";
@@ -193,6 +248,12 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   if (!built.sources.imu) {
     POSED_LOG_ERROR("%s", error.c_str());
     return 1;
+  }
+  std::shared_ptr<const mapping::KeyframeMap> prior_map;
+  if (!options.prior_map_dir.empty()) {
+    prior_map = load_prior_map(options.prior_map_dir);
+    if (!prior_map) return 1;
+    built.sources.prior_map = prior_map;
   }
   // Owned by the pipeline, which outlives every use below.
   const drivers::SyntheticImuSource* synthetic = built.synthetic;
@@ -367,6 +428,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
       exit_code = 1;
       break;
     }
+    replay.built.sources.prior_map = prior_map;
     // The last pass's pipeline, with its Sources, goes before the next one is built, and the
     // heap it freed goes back to the system: glibc keeps freed memory in its arenas, and the
     // next pass's threads and allocations rarely fit the same holes, so without the trim
@@ -398,6 +460,11 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   std::string map_line;
   if (!options.map_path.empty() && !save_map(*pipe, options.map_path, to_wall, map_line))
     exit_code = 1;
+  if (!options.map_dir.empty()) {
+    std::string dir_line;
+    if (!save_map_directory(*pipe, options.map_dir, to_wall, dir_line)) exit_code = 1;
+    map_line += (map_line.empty() ? "" : "; ") + dir_line;
+  }
 
   const RunSummary summary{
       config,         options,          *pipe,          sinks,    started,     pipeline_started,

@@ -18,9 +18,14 @@ struct RunOptions {
   std::string record_path;
   /// with record_path: the DDS outputs recorded too, as ros2msg channels (parse_record_outputs)
   std::string record_outputs = "tf,tf_static,path,diagnostics,status";
-  /// at the end of the run, write the lidar map here (PCD) and the keyframe poses next to it
-  /// (keyframes_path_for()); empty = keep no map
+  /// at the end of the run, write the estimator's lidar map here (PCD) and the keyframe poses
+  /// next to it (keyframes_path_for()); empty = keep no map
   std::string map_path;
+  /// at the end of the run, write the mapping stage's loop-closed keyframe map to this directory
+  /// (drivers/recording/map_directory.hpp), which --map loads; empty = none
+  std::string map_dir;
+  /// localise on the keyframe map in this directory (posed --map DIR); empty = map as you go
+  std::string prior_map_dir;
   /// replay this recording instead of opening the sensors (replay.path empty = live)
   pipeline::ReplayOptions replay;
   /// before the first sample, wait up to this long for a DDS reader of odom or pose to match;
@@ -32,6 +37,9 @@ struct RunOptions {
 
 /// Where the keyframe poses of a map saved to `map_path` go: MAP.pcd -> MAP.keyframes.tum.
 std::string keyframes_path_for(const std::string& map_path);
+/// Whether --save-map PATH names a keyframe map directory (RunOptions::map_dir) rather than a PCD
+/// file (RunOptions::map_path): whether it does not end in .pcd.
+bool is_map_directory_path(const std::string& map_path);
 
 /// Returns the process exit code.
 int run_daemon(const config::PosedConfig& config, const RunOptions& options);

@@ -27,7 +27,48 @@ double yaw_deg(const Eigen::Quaterniond& q) {
 namespace {
 
 /// The mapping stage's line: loops closed, candidates refused and why, the correction, the cost.
-void print_mapping_summary(const pipeline::MappingFigures& m) {
+/// The localiser's line (posed --map): where it ended, how soon the first fix came, how it
+/// tracked.
+void print_localisation_summary(const pipeline::MappingFigures& m, const HostToWall& to_wall) {
+  const mapping::LocalisationFigures& f = m.localisation;
+  char first_fix[128] = "no fix";
+  if (f.first_fix && f.first_scan) {
+    // The stamp as posed's poses carry it, so evaluations can tell which were localised.
+    std::snprintf(first_fix, sizeof first_fix, "first fix after %.2f s of data (at %.3f s)",
+                  static_cast<double>(f.first_fix->ns - f.first_scan->ns) * 1e-9,
+                  to_wall(*f.first_fix).seconds());
+  }
+  const auto refused = [&](mapping::RegistrationVerdict v) {
+    return static_cast<unsigned long long>(f.rejected[static_cast<std::size_t>(v)]);
+  };
+  const std::uint64_t registrations =
+      f.fixes + f.rejected[1] + f.rejected[2] + f.rejected[3] + f.rejected[4] + f.rejected[5];
+  std::printf(
+      "  localisation        %s; %s; %llu fixes over %llu tracking attempts and %llu lookups; "
+      "lost %llu times\n",
+      std::string(mapping::state_name(m.state)).c_str(), first_fix,
+      static_cast<unsigned long long>(f.fixes), static_cast<unsigned long long>(f.track_attempts),
+      static_cast<unsigned long long>(f.lookups), static_cast<unsigned long long>(f.times_lost));
+  std::printf(
+      "                      refused: %llu degenerate, %llu not close, %llu low overlap, %llu "
+      "diverged, %llu unconfirmed, %llu off the map; registered in %.1f ms on average; map -> "
+      "odom %.3f m, %.2f deg%s\n",
+      refused(mapping::RegistrationVerdict::kDegenerate),
+      refused(mapping::RegistrationVerdict::kNotClose),
+      refused(mapping::RegistrationVerdict::kLowOverlap),
+      refused(mapping::RegistrationVerdict::kDiverged),
+      static_cast<unsigned long long>(f.unconfirmed), static_cast<unsigned long long>(f.off_map),
+      registrations > 0 ? 1e3 * f.registration_time_s / static_cast<double>(registrations) : 0.0,
+      m.T_map_odom.translation().norm(),
+      Eigen::AngleAxisd(m.T_map_odom.rotation()).angle() * 180.0 / M_PI,
+      m.keyframes_dropped > 0 ? " (some scans skipped: the mapping thread fell behind)" : "");
+}
+
+void print_mapping_summary(const pipeline::MappingFigures& m, const HostToWall& to_wall) {
+  if (m.localising) {
+    print_localisation_summary(m, to_wall);
+    return;
+  }
   const mapping::LoopClosureFigures& f = m.loops;
   std::uint64_t by_descriptor = 0;
   for (const mapping::LoopRecord& loop : m.accepted) by_descriptor += loop.by_descriptor ? 1 : 0;
@@ -234,7 +275,7 @@ bool print_run_summary(const RunSummary& r) {
                 static_cast<unsigned long long>(rc.dropped));
   }
   if (!r.map_line.empty()) std::printf("  map                 %s\n", r.map_line.c_str());
-  if (const auto mapping = r.pipe.mapping_figures()) print_mapping_summary(*mapping);
+  if (const auto mapping = r.pipe.mapping_figures()) print_mapping_summary(*mapping, r.sinks.to_wall());
   if (tally.last) {
     const NavState& s = *tally.last;
     std::printf("  final pose          x %.3f m, y %.3f m, z %.3f m, yaw %.1f deg\n",

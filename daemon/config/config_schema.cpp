@@ -552,6 +552,21 @@ const Field kSchema[] = {
     F("mapping.queue_capacity", mapping.queue_capacity, "64", "scans", 4, 4096, "",
       "scans waiting for the mapping thread; live, a keyframe that finds it full is left out "
       "(counted; the graph bridges it by odometry), a replay waits"),
+    F("mapping.localise_every_m", mapping.localise_every_m, "2", "m", 0.1, 100, "",
+      "localising on a prior map (posed --map): once localised, register the scan onto the map "
+      "after moving this far"),
+    F("mapping.lost_after_m", mapping.lost_after_m, "25", "m", 1, 10000, "",
+      "localising: travel without a verified registration after which the state is lost and the "
+      "place is looked up again"),
+    F("mapping.initial_pose_given", mapping.initial_pose_given, "false", "", 0, 0, "",
+      "localising: start from mapping.initial_* instead of looking the place up by descriptor "
+      "(rt/initialpose does the same at run time)"),
+    F("mapping.initial_x_m", mapping.initial_x_m, "0", "m", -1e6, 1e6, "",
+      "localising: base_link's x in the map at start (with initial_pose_given)"),
+    F("mapping.initial_y_m", mapping.initial_y_m, "0", "m", -1e6, 1e6, "", "and its y"),
+    F("mapping.initial_z_m", mapping.initial_z_m, "0", "m", -1e6, 1e6, "", "and its z"),
+    F("mapping.initial_yaw_deg", mapping.initial_yaw_deg, "0", "deg", -360, 360, "",
+      "and its heading about the map's z"),
 };
 
 #undef F

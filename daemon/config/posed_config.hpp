@@ -288,6 +288,16 @@ struct MappingSection {
   double min_overlap = 0.5;                 ///< and its overlap at least [0..1]
   double min_constraint = 0.02;  ///< and its weakest direction's information share [0..1]
   int queue_capacity = 64;       ///< scans waiting for the mapping thread (live) [1]
+  // Localisation on a prior map (posed --map DIR).
+  double localise_every_m = 2.0;  ///< localised: a registration onto the map this often [m]
+  double lost_after_m = 25.0;     ///< travel without a verified fix after which it is lost [m]
+  /// start from the pose below rather than look the place up by descriptor (as hdl_localization's
+  /// specify_init_pose; rt/initialpose does the same at run time)
+  bool initial_pose_given = false;
+  double initial_x_m = 0;      ///< base_link in the map [m]
+  double initial_y_m = 0;      ///< [m]
+  double initial_z_m = 0;      ///< [m]
+  double initial_yaw_deg = 0;  ///< heading about the map's z [deg]
 };
 
 struct WatchdogSection {

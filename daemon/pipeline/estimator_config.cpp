@@ -95,4 +95,25 @@ mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config
   return c;
 }
 
+mapping::LocalisationConfig localisation_config(const config::PosedConfig& config) {
+  const config::MappingSection& m = config.mapping;
+  mapping::LocalisationConfig c;
+  c.keyframe_distance_m = m.localise_every_m;
+  c.keyframe_angle_rad = config.estimator.keyframe_angle_deg * M_PI / 180.0;
+  c.lost_after_m = m.lost_after_m;
+  c.registration.max_rms_m = m.max_rms_m;
+  c.registration.min_overlap = m.min_overlap;
+  c.registration.min_constraint = m.min_constraint;
+  return c;
+}
+
+Eigen::Isometry3d initial_pose(const config::MappingSection& m) {
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  T_map_base.translation() = Eigen::Vector3d(m.initial_x_m, m.initial_y_m, m.initial_z_m);
+  T_map_base.linear() =
+      Eigen::AngleAxisd(m.initial_yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
+  return T_map_base;
+}
+
 }  // namespace posed::pipeline

@@ -4,6 +4,7 @@
 
 #include "core/estimator/lio_estimator.hpp"
 #include "core/estimator/strapdown.hpp"
+#include "core/mapping/localiser.hpp"
 #include "core/mapping/loop_closer.hpp"
 #include "daemon/config/posed_config.hpp"
 
@@ -13,6 +14,11 @@ estimator::LioConfig lio_config(const config::PosedConfig& config);
 StrapdownConfig strapdown_config(const config::PosedConfig& config);
 /// The mapping stage's loop closer: mapping.* and the estimator's keyframe spacing.
 mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config);
+/// The mapping stage's localiser on a prior map: mapping.localise_every_m, lost_after_m and the
+/// registration's tests.
+mapping::LocalisationConfig localisation_config(const config::PosedConfig& config);
+/// mapping.initial_* as base_link in the map.
+Eigen::Isometry3d initial_pose(const config::MappingSection& m);
 
 /// A 4x4 row-major config transform as an isometry.
 Eigen::Isometry3d to_isometry(const config::Transform4& T);

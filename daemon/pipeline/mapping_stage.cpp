@@ -7,7 +7,8 @@
 namespace posed::pipeline {
 
 MappingStage::MappingStage(const config::PosedConfig& config, bool in_data_order,
-                           Heartbeat& heartbeat)
+                           Heartbeat& heartbeat,
+                           std::shared_ptr<const mapping::KeyframeMap> prior_map)
     : in_data_order_(in_data_order),
       capacity_(static_cast<std::size_t>(config.mapping.queue_capacity)),
       T_base_lidar_(to_isometry(config.extrinsics.T_imu_lidar)),
@@ -15,6 +16,18 @@ MappingStage::MappingStage(const config::PosedConfig& config, bool in_data_order
       closer_(loop_closure_config(config)),
       selector_(closer_.config().keyframe_distance_m, closer_.config().keyframe_angle_rad) {
   corrections_.emplace_back(0, Eigen::Isometry3d::Identity());
+  if (prior_map) {
+    localiser_.emplace(*prior_map, localisation_config(config));
+    figures_.localising = true;
+    if (config.mapping.initial_pose_given) {
+      initial_T_map_base_ = initial_pose(config.mapping);
+    }
+  }
+}
+
+void MappingStage::set_initial_pose(const Eigen::Isometry3d& T_map_base) {
+  std::lock_guard lock(mutex_);
+  initial_T_map_base_ = T_map_base;
 }
 
 void MappingStage::after_scan(const FusionCore& core) {
@@ -24,8 +37,9 @@ void MappingStage::after_scan(const FusionCore& core) {
   if (core.latest_matched_scan(scan) && scan.index != last_scan_index_) {
     last_scan_index_ = scan.index;
     const Eigen::Isometry3d T_odom_base = scan.T_map_lidar * T_base_lidar_.inverse();
-    if (selector_.take(T_odom_base)) {
-      item.keyframe = true;
+    // Localising needs every scan: while aligning each is a lookup.
+    if (localiser_ || selector_.take(T_odom_base)) {
+      item.has_scan = true;
       item.stamp = scan.stamp;
       item.T_odom_base = T_odom_base;
       item.points_base.reserve(scan.points_lidar.size());
@@ -50,10 +64,11 @@ void MappingStage::push(Item item) {
     if (in_data_order_) {
       // A replay waits for the mapping thread rather than lose a keyframe.
       progress_.wait(lock, [this] { return queue_.size() < capacity_; });
-    } else if (queue_.size() >= capacity_ && item.keyframe) {
-      // Live, the fusion thread never waits: the keyframe's cloud is let go (the scan still
-      // counts, so later states find their place), and the graph bridges the gap by odometry.
-      item.keyframe = false;
+    } else if (queue_.size() >= capacity_ && item.has_scan) {
+      // Live, the fusion thread never waits: the scan's cloud is let go (the scan still counts,
+      // so later states find their place); the graph bridges the gap by odometry, and the
+      // localiser waits for the next scan.
+      item.has_scan = false;
       item.points_base = {};
       ++figures_.keyframes_dropped;
     }
@@ -81,34 +96,81 @@ void MappingStage::run() {
       ended_ = true;
       break;
     }
-    const std::size_t loops_before = closer_.loops().size();
-    if (item.keyframe) {
-      closer_.add_keyframe(item.stamp, item.T_odom_base, item.points_base);
+    take(item);
+    progress_.notify_all();
+  }
+  progress_.notify_all();
+}
+
+bool MappingStage::take(Item& item) {
+  if (localiser_) {
+    std::optional<Eigen::Isometry3d> initial;
+    {
+      std::lock_guard lock(mutex_);
+      initial.swap(initial_T_map_base_);
     }
-    const std::size_t loops_now = closer_.loops().size();
+    if (initial) {
+      localiser_->set_initial_pose(*initial);
+      POSED_LOG_NOTICE("mapping: initial pose (%.2f, %.2f, %.2f) m in the map",
+                       initial->translation().x(), initial->translation().y(),
+                       initial->translation().z());
+    }
+    const mapping::LocalisationState state_before = localiser_->state();
+    const std::uint64_t fixes_before = localiser_->figures().fixes;
+    if (item.has_scan) {
+      localiser_->add_scan(item.stamp, item.T_odom_base, item.points_base);
+    }
+    const mapping::LocalisationFigures& f = localiser_->figures();
+    const bool changed = f.fixes != fixes_before;
     {
       std::lock_guard lock(mutex_);
       ++taken_;
       ++figures_.scans;
-      figures_.loops = closer_.figures();
-      if (loops_now != loops_before) {
-        corrections_.emplace_back(taken_, closer_.T_map_odom());
-        figures_.accepted = closer_.loops();
-        figures_.T_map_odom = closer_.T_map_odom();
+      figures_.state = localiser_->state();
+      figures_.localisation = f;
+      if (changed) {
+        corrections_.emplace_back(taken_, localiser_->T_map_odom());
+        figures_.T_map_odom = localiser_->T_map_odom();
       }
     }
-    if (loops_now != loops_before) {
-      const mapping::LoopRecord& loop = closer_.loops().back();
+    if (localiser_->state() != state_before) {
+      const Eigen::Vector3d p = (localiser_->T_map_odom() * item.T_odom_base).translation();
       POSED_LOG_NOTICE(
-          "mapping: loop %zu at %.3f s: keyframe %zu -> %zu (%s), fit %.3f m, overlap %.2f, "
-          "correction %.2f m; map -> odom now %.2f m off",
-          loops_now, loop.stamp.seconds(), loop.query, loop.candidate,
-          loop.by_descriptor ? "descriptor" : "distance", loop.rms_m, loop.overlap,
-          loop.correction_m, closer_.T_map_odom().translation().norm());
+          "mapping: %s at %.3f s (at (%.2f, %.2f, %.2f) m in the map; fit %.3f m, "
+          "overlap %.2f; %llu lookups, %llu fixes)",
+          std::string(mapping::state_name(localiser_->state())).c_str(), item.stamp.seconds(),
+          p.x(), p.y(), p.z(), f.last_fix_rms_m, f.last_fix_overlap,
+          static_cast<unsigned long long>(f.lookups), static_cast<unsigned long long>(f.fixes));
     }
-    progress_.notify_all();
+    return changed;
   }
-  progress_.notify_all();
+  const std::size_t loops_before = closer_.loops().size();
+  if (item.has_scan) {
+    closer_.add_keyframe(item.stamp, item.T_odom_base, item.points_base);
+  }
+  const std::size_t loops_now = closer_.loops().size();
+  {
+    std::lock_guard lock(mutex_);
+    ++taken_;
+    ++figures_.scans;
+    figures_.loops = closer_.figures();
+    if (loops_now != loops_before) {
+      corrections_.emplace_back(taken_, closer_.T_map_odom());
+      figures_.accepted = closer_.loops();
+      figures_.T_map_odom = closer_.T_map_odom();
+    }
+  }
+  // A confirmed descriptor loop accepts two at once: each is logged.
+  for (std::size_t i = loops_before; i < loops_now; ++i) {
+    const mapping::LoopRecord& loop = closer_.loops()[i];
+    POSED_LOG_NOTICE(
+        "mapping: loop %zu at %.3f s: keyframe %zu -> %zu (%s), fit %.3f m, overlap %.2f, "
+        "correction %.2f m; map -> odom now %.2f m off",
+        i + 1, loop.stamp.seconds(), loop.query, loop.candidate,
+        loop.by_descriptor ? "descriptor" : "distance", loop.rms_m, loop.overlap, loop.correction_m,
+        closer_.T_map_odom().translation().norm());
+  }
+  return loops_now != loops_before;
 }
 
 bool MappingStage::wait_until_taken(std::uint64_t scans, std::chrono::milliseconds timeout) {
@@ -135,11 +197,21 @@ Eigen::Isometry3d MappingStage::T_map_odom(std::uint64_t scans_before) const {
 
 std::vector<std::pair<HostTime, Eigen::Isometry3d>> MappingStage::optimised_keyframes() const {
   std::vector<std::pair<HostTime, Eigen::Isometry3d>> out;
+  if (localiser_) {
+    return out;
+  }
   out.reserve(closer_.keyframe_count());
   for (std::size_t i = 0; i < closer_.keyframe_count(); ++i) {
     out.emplace_back(closer_.keyframe_stamp(i), closer_.T_map_keyframe(i));
   }
   return out;
+}
+
+mapping::KeyframeMap MappingStage::built_map() const {
+  if (localiser_) {
+    return {};
+  }
+  return closer_.snapshot();
 }
 
 MappingFigures MappingStage::figures() const {

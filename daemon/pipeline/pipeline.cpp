@@ -234,9 +234,10 @@ bool Pipeline::start(std::string& error) {
   // Loops and map -> odom on a thread of their own, from the lidar-inertial estimate's scans.
   std::vector<ScanObserver*> scan_observers;
   if (outputs_.scan_observer != nullptr) scan_observers.push_back(outputs_.scan_observer);
-  if (config_.mapping.loop_closure && lio != nullptr) {
+  if ((config_.mapping.loop_closure || sources_.prior_map) && lio != nullptr) {
     add_stage("mapping", [&](Heartbeat& beat) {
-      mapping_stage_ = std::make_unique<MappingStage>(config_, in_stamp_order, beat);
+      mapping_stage_ =
+          std::make_unique<MappingStage>(config_, in_stamp_order, beat, sources_.prior_map);
       return [this] { mapping_stage_->run(); };
     });
     scan_observers.push_back(mapping_stage_.get());
@@ -324,6 +325,17 @@ std::vector<std::pair<HostTime, Eigen::Isometry3d>> Pipeline::optimised_keyframe
   return mapping_stage_->optimised_keyframes();
 }
 
+mapping::KeyframeMap Pipeline::built_map() const {
+  if (!mapping_stage_) return {};
+  return mapping_stage_->built_map();
+}
+
+bool Pipeline::set_initial_pose(const Eigen::Isometry3d& T_map_base) {
+  if (!mapping_stage_ || !sources_.prior_map) return false;
+  mapping_stage_->set_initial_pose(T_map_base);
+  return true;
+}
+
 std::vector<CameraFigures> Pipeline::camera_compare_figures() const {
   return camera_core_ ? camera_core_->cameras().compare_figures() : std::vector<CameraFigures>{};
 }
@@ -356,6 +368,17 @@ PipelineStatus Pipeline::status() const {
   st.states = fusion_counters_->states.load();
   st.states_dropped = state_queue_.counters().dropped();
   st.estimator = fusion_counters_->figures();
+  if (mapping_stage_) {
+    const MappingFigures m = mapping_stage_->figures();
+    MappingStatus& ms = st.mapping.emplace();
+    ms.localising = m.localising;
+    ms.state = m.localising ? std::string(mapping::state_name(m.state)) : "mapping";
+    ms.keyframes = m.loops.keyframes;
+    ms.loops = m.loops.loops;
+    ms.fixes = m.localisation.fixes;
+    ms.correction_m = m.T_map_odom.translation().norm();
+    ms.scans_skipped = m.keyframes_dropped;
+  }
 
   StreamStatus imu;
   imu.name = "imu";

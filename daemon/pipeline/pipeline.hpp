@@ -67,6 +67,9 @@ struct PipelineSources {
   std::string lidar_calibration_text;
   /// where that text came from, for messages
   std::string lidar_calibration_name;
+  /// a keyframe map to localise on (posed --map DIR): the mapping stage localises on it instead
+  /// of closing loops; null: none
+  std::shared_ptr<const mapping::KeyframeMap> prior_map;
   /// recordings replayed at recorded timing (or N times it), not as fast as they go: the
   /// odometry then runs as it would live rather than waiting for the back end
   bool paced = false;
@@ -160,6 +163,11 @@ class Pipeline {
   std::optional<MappingFigures> mapping_figures() const;
   /// The mapping stage's keyframes, optimised (call after join(); empty without one).
   std::vector<std::pair<HostTime, Eigen::Isometry3d>> optimised_keyframes() const;
+  /// The mapping stage's map (after join(); empty without one, or when localising).
+  mapping::KeyframeMap built_map() const;
+  /// Localising: where base_link is in the map now (rt/initialpose); any thread. False without
+  /// a prior map.
+  bool set_initial_pose(const Eigen::Isometry3d& T_map_base);
   /// The comparison front ends' figures (call after join(); empty without them).
   std::vector<CameraFigures> camera_compare_figures() const;
 

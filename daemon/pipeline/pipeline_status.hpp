@@ -2,6 +2,7 @@
 // The pipeline's figures for rt/posed/status, the systemd STATUS= line and the exit summary.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,18 @@
 #include "core/time.hpp"
 
 namespace posed::pipeline {
+
+/// The mapping stage's figures, for rt/diagnostics and the status line.
+struct MappingStatus {
+  bool localising = false;  ///< on a prior map (posed --map), not closing loops
+  /// localising: "aligning", "localised" or "lost"; closing loops: "mapping"
+  std::string state;
+  std::uint64_t keyframes = 0;      ///< closing loops: keyframes in the graph [1]
+  std::uint64_t loops = 0;          ///< closing loops: accepted [1]
+  std::uint64_t fixes = 0;          ///< localising: verified registrations onto the map [1]
+  double correction_m = 0;          ///< map -> odom's translation [m]
+  std::uint64_t scans_skipped = 0;  ///< live: scans the full queue kept from the stage [1]
+};
 
 /// Per-stream figures.
 struct StreamStatus {
@@ -51,6 +64,8 @@ struct PipelineStatus {
   std::uint64_t imu_backup_used = 0;  ///< its samples the estimate used
   std::uint64_t states = 0;           ///< states produced by the fusion core
   std::uint64_t states_dropped = 0;   ///< states dropped between fusion and publisher
+  /// the mapping stage (none without one)
+  std::optional<MappingStatus> mapping;
 };
 
 }  // namespace posed::pipeline

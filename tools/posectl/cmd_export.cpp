@@ -25,8 +25,8 @@ namespace rec = drivers::recording;
 namespace {
 
 /// Replays `path` through the daemon's pipeline without DDS and saves the map.
-int export_map(const std::string& path, const std::string& config_path,
-               const std::string& pcd_path) {
+int export_map(const std::string& path, const std::string& config_path, const std::string& pcd_path,
+               const std::string& map_dir) {
   config::LoadResult loaded =
       config_path.empty() ? config::LoadResult{} : config::load_config_file(config_path);
   if (config_path.empty()) loaded.config = config::default_config();
@@ -38,6 +38,7 @@ int export_map(const std::string& path, const std::string& config_path,
   options.replay.path = path;
   options.replay.rate = 0;  // max speed: lossless and deterministic
   options.map_path = pcd_path;
+  options.map_dir = map_dir;
   options.publish_dds = false;
   std::fprintf(stderr,
                "posectl export: replaying %s through posed's pipeline to build the map...\n",
@@ -56,27 +57,33 @@ int run_export(int argc, char** argv) {
       "quaternion x y z w) from a PoseStamped\n         or Odometry channel in the file.\n"
       "  --pcd: the lidar map, built by replaying the raw lidar and IMU channels through posed's\n"
       "         pipeline at full speed (no DDS): a binary PCD (x y z [m], map frame) and the\n"
-      "         keyframe poses next to it (MAP.keyframes.tum).",
+      "         keyframe poses next to it (MAP.keyframes.tum).\n"
+      "  --map-dir: the loop-closed keyframe map, built the same way, as a directory posed --map\n"
+      "         loads (docs/mapping.md).",
       "posectl export"};
-  std::string path, tum_path, pcd_path, topic, config_path;
+  std::string path, tum_path, pcd_path, map_dir, topic, config_path;
   app.add_option("FILE", path, "MCAP recording")->required()->check(CLI::ExistingFile);
   app.add_option("--tum", tum_path, "TUM trajectory to write");
   app.add_option("--topic", topic,
                  "pose channel for --tum; default: the only one, or posed's /posed/pose in a posed "
                  "recording (which also holds /posed/odom)");
   app.add_option("--pcd", pcd_path, "map to write (PCD)");
+  app.add_option("--map-dir", map_dir,
+                 "loop-closed keyframe map to write to this directory, as posed --save-map DIR "
+                 "(what posed --map DIR loads; docs/mapping.md)");
   app.add_option("-c,--config", config_path,
                  "posed configuration for --pcd (rig, estimator); default: the built-in defaults, "
                  "the rig of config/posed.yaml")
       ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
-  if (tum_path.empty() && pcd_path.empty()) {
+  if (tum_path.empty() && pcd_path.empty() && map_dir.empty()) {
     std::fprintf(stderr,
-                 "posectl export: nothing to do: give --tum OUT.txt and/or --pcd MAP.pcd\n");
+                 "posectl export: nothing to do: give --tum OUT.txt, --pcd MAP.pcd and/or "
+                 "--map-dir DIR\n");
     return 2;
   }
-  if (!pcd_path.empty()) {
-    const int rc = export_map(path, config_path, pcd_path);
+  if (!pcd_path.empty() || !map_dir.empty()) {
+    const int rc = export_map(path, config_path, pcd_path, map_dir);
     if (rc != 0 || tum_path.empty()) return rc;
   }
 
