@@ -132,6 +132,33 @@ TEST_F(CdrLoop, PoseStampedBytesMatchRos2Layout) {
   free_sample(geometry_msgs_msg_dds__PoseStamped__desc, out);
 }
 
+TEST_F(CdrLoop, PoseWithCovarianceStampedBytesMatchRos2Layout) {
+  // What RViz's 2D Pose Estimate sends on /initialpose: header, pose, then 36 doubles.
+  char frame[] = "map";  // 4 bytes with NUL: the doubles need no padding
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ in{};
+  in.header.stamp = {1'700'000'000, 5};
+  in.header.frame_id = frame;
+  in.pose.pose.position = {1.5, -2.25, 0.0};
+  in.pose.pose.orientation = {0.0, 0.0, 0.6, 0.8};
+  for (int i = 0; i < 36; ++i) in.pose.covariance[i] = 0.5 * i;
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ out{};
+  const auto bytes = round_trip(geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc, in, out);
+
+  CdrBuilder expected;
+  expected.put<std::int32_t>(1'700'000'000);
+  expected.put<std::uint32_t>(5);
+  expected.put_string("map");
+  for (double v : {1.5, -2.25, 0.0, 0.0, 0.0, 0.6, 0.8}) expected.put(v);
+  for (int i = 0; i < 36; ++i) expected.put(0.5 * i);
+  ASSERT_EQ(expected.bytes.size(), 4u + 360u);  // 4 + 4 + 4 + 4 + 7 * 8 + 36 * 8
+  EXPECT_EQ(bytes, expected.bytes);
+
+  EXPECT_STREQ(out.header.frame_id, "map");
+  EXPECT_EQ(out.pose.pose.orientation.z, 0.6);
+  EXPECT_EQ(out.pose.covariance[35], 17.5);
+  free_sample(geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc, out);
+}
+
 TEST_F(CdrLoop, TimeBytesAreSecThenNanosec) {
   builtin_interfaces_msg_dds__Time_ in{-5, 999'999'999};
   builtin_interfaces_msg_dds__Time_ out{};

@@ -32,6 +32,8 @@ TEST(DdsTypeNames, MatchRosidlDdsNames) {
                "geometry_msgs::msg::dds_::TwistWithCovariance_");
   EXPECT_STREQ(geometry_msgs_msg_dds__PoseStamped__desc.m_typename,
                "geometry_msgs::msg::dds_::PoseStamped_");
+  EXPECT_STREQ(geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc.m_typename,
+               "geometry_msgs::msg::dds_::PoseWithCovarianceStamped_");
   EXPECT_STREQ(nav_msgs_msg_dds__Odometry__desc.m_typename, "nav_msgs::msg::dds_::Odometry_");
   EXPECT_STREQ(posed_msgs_msg_dds__StreamStatus__desc.m_typename,
                "posed_msgs::msg::dds_::StreamStatus_");
@@ -50,6 +52,7 @@ TEST(DdsTypeNames, ROS2TypesHaveNoKey) {
   // ROS 2 messages are keyless; a key would change the wire (key hash) and instance handling.
   EXPECT_EQ(nav_msgs_msg_dds__Odometry__desc.m_nkeys, 0u);
   EXPECT_EQ(geometry_msgs_msg_dds__PoseStamped__desc.m_nkeys, 0u);
+  EXPECT_EQ(geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc.m_nkeys, 0u);
   EXPECT_EQ(posed_msgs_msg_dds__Status__desc.m_nkeys, 0u);
 }
 
