@@ -393,6 +393,9 @@ struct DdsConfig {
   bool map = true;
   /// create a writer for rt/posed/image/compressed (publish.image)
   bool image = true;
+  /// DDS topic the initial pose is read from (InitialPoseReader, dds.initialpose_topic), as
+  /// RViz's 2D Pose Estimate publishes /initialpose; empty: none read
+  std::string initial_pose_topic = "rt/initialpose";
   /// DDS Security; empty files: none
   DdsSecurityFiles security;
 };

@@ -225,6 +225,29 @@ dds_entity_t create_topic(dds_entity_t participant, Topic topic, std::string& er
   return handle;
 }
 
+dds_qos_t* make_initial_pose_qos() {
+  dds_qos_t* qos = dds_create_qos();
+  // RViz creates its publisher with rclcpp::QoS(5): ROS 2's default profile at a depth of 5.
+  // Volatile: a pose given before posed started is stale, not an instruction to replay.
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 5);
+  const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+  dds_qset_data_representation(qos, 1, &xcdr1);
+  return qos;
+}
+
+dds_entity_t create_initial_pose_topic(dds_entity_t participant, const std::string& name,
+                                       std::string& error) {
+  dds_qos_t* qos = make_initial_pose_qos();
+  const dds_entity_t handle =
+      dds_create_topic(participant, &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc,
+                       name.c_str(), qos, nullptr);
+  dds_delete_qos(qos);
+  if (handle < 0) error = describe_error(name + ": create topic", handle);
+  return handle;
+}
+
 std::string describe_error(std::string_view what, dds_return_t rc) {
   return std::string(what) + ": " + dds_strretcode(rc);
 }

@@ -43,6 +43,14 @@ const dds_topic_descriptor_t& descriptor(Topic topic);
 /// Creates the topic `topic` of the type its descriptor names; error names the topic.
 dds_entity_t create_topic(dds_entity_t participant, Topic topic, std::string& error);
 
+/// QoS of rt/initialpose on both ends, as RViz's "2D Pose Estimate" tool publishes it
+/// (rclcpp::QoS(5): reliable, volatile, keep-last 5), XCDR1. Caller deletes with dds_delete_qos.
+dds_qos_t* make_initial_pose_qos();
+
+/// Creates the topic `name` of geometry_msgs/PoseWithCovarianceStamped; error names the topic.
+dds_entity_t create_initial_pose_topic(dds_entity_t participant, const std::string& name,
+                                       std::string& error);
+
 /// "<what>: <Cyclone's reason>", e.g. "rt/posed/odom: create writer: Bad parameter"
 std::string describe_error(std::string_view what, dds_return_t rc);
 

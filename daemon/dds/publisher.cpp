@@ -20,7 +20,7 @@ WallTime first_stamp(const TfMessage& msg) {
 }  // namespace
 
 struct Publisher::Impl {
-  std::unique_ptr<detail::Participant> participant;
+  std::shared_ptr<detail::Participant> participant;
   /// writer per Topic (index = enum value); 0 for a topic the DdsConfig leaves off
   std::array<dds_entity_t, kAllTopics.size()> writers{};
   // Frame ids live here for the publisher's lifetime; the samples point into them.
@@ -184,5 +184,7 @@ std::uint32_t Publisher::matched_subscribers(Topic topic) const {
 std::uint64_t Publisher::write_failures() const {
   return impl_->write_failures.load(std::memory_order_relaxed);
 }
+
+std::shared_ptr<detail::Participant> Publisher::participant() const { return impl_->participant; }
 
 }  // namespace posed::dds

@@ -15,6 +15,9 @@
 namespace posed::dds {
 
 class MessageTap;
+namespace detail {
+class Participant;
+}
 
 /// One DDS participant with a writer per topic. Publishing reuses preallocated samples (frame
 /// ids fixed at creation), so it allocates nothing beyond what Cyclone does per write.
@@ -62,6 +65,11 @@ class Publisher {
   std::uint32_t matched_subscribers(Topic topic) const;
   /// Writes Cyclone rejected since creation [count].
   std::uint64_t write_failures() const;
+
+  /// The participant the writers live on, for a reader in daemon/dds that shares it
+  /// (InitialPoseReader::create): one participant per daemon, one discovery and one DDS Security
+  /// handshake. It stays alive while either holds it.
+  std::shared_ptr<detail::Participant> participant() const;
 
  private:
   struct Impl;
