@@ -205,6 +205,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   dds_config.odom_frame = config.dds.odom_frame;
   dds_config.base_frame = config.dds.base_frame;
   dds_config.cyclonedds_xml_path = config.dds.cyclonedds_config;
+  dds_config.initial_pose_topic = config.dds.initialpose_topic;
   dds_config.security = dds_security_files(config.dds.security);
   dds_config.tf = config.publish.tf;
   dds_config.path = config.publish.path;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -550,9 +551,41 @@ void check_dds_security(const DdsSecuritySection& s, std::string_view file, cons
   }
 }
 
+/// A DDS topic posed reads must be a ROS 2 topic's DDS name, "rt/" then ROS name tokens
+/// (letters, digits, _; not starting with a digit) joined by single slashes: a ROS name such as
+/// /initialpose would otherwise give a reader no ROS 2 publisher ever matches, silently.
+void check_dds_topic(const std::string& topic, const std::string& key, std::string_view file,
+                     const Loader& loader, std::vector<ConfigError>& errors) {
+  if (topic.empty()) return;
+  const auto [line, column] = loader.place_of(key);
+  if (topic.front() == '/') {
+    errors.push_back({std::string(file), line, column, key,
+                      "'" + topic + "' is a ROS name; its DDS name is rt" + topic +
+                          " (ROS 2 prefixes topics with rt/)"});
+    return;
+  }
+  bool ok = topic.size() > 3 && topic.compare(0, 3, "rt/") == 0;
+  std::size_t token_start = 3;
+  for (std::size_t i = 3; ok && i <= topic.size(); ++i) {
+    if (i == topic.size() || topic[i] == '/') {
+      ok = i > token_start && !std::isdigit(static_cast<unsigned char>(topic[token_start]));
+      token_start = i + 1;
+    } else {
+      ok = std::isalnum(static_cast<unsigned char>(topic[i])) || topic[i] == '_';
+    }
+  }
+  if (!ok) {
+    errors.push_back({std::string(file), line, column, key,
+                      "'" + topic +
+                          "' is not a ROS 2 topic's DDS name (rt/ then names of letters, digits "
+                          "and _ joined by /, e.g. rt/initialpose)"});
+  }
+}
+
 void check_cross_field(const PosedConfig& c, std::string_view file, const Loader& loader,
                        std::vector<ConfigError>& errors) {
   check_dds_security(c.dds.security, file, loader, errors);
+  check_dds_topic(c.dds.initialpose_topic, "dds.initialpose_topic", file, loader, errors);
   if (c.lidar.min_range_m >= c.lidar.max_range_m) {
     errors.push_back(
         {std::string(file), 0, 0, "lidar.min_range_m", "must be below lidar.max_range_m"});

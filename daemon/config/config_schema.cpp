@@ -34,6 +34,9 @@ const Field kSchema[] = {
       "frame of the thermal camera in rt/tf_static (extrinsics.T_imu_cam * T_cam_thermal)"),
     P("dds.cyclonedds_config", dds.cyclonedds_config,
       "Cyclone DDS XML file; empty uses CYCLONEDDS_URI or Cyclone's default"),
+    F("dds.initialpose_topic", dds.initialpose_topic, "rt/initialpose", "", 0, 0, "",
+      "DDS topic of the initial pose for localisation on a map (--map), as RViz's 2D Pose "
+      "Estimate publishes /initialpose; a ROS 2 topic's DDS name (rt/...); empty: none read"),
     P("dds.security.enclave", dds.security.enclave,
       "DDS Security: SROS2 enclave directory (posectl security init DIR makes DIR/enclaves/posed); "
       "or the six files below; none: plain DDS"),

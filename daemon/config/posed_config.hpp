@@ -39,6 +39,8 @@ struct DdsSection {
   std::string thermal_frame;  ///< rt/tf_static child of base_link: T_imu_cam * T_cam_thermal
   /// Cyclone DDS XML file; empty = CYCLONEDDS_URI or Cyclone's built-in default
   std::string cyclonedds_config;
+  /// DDS topic of the initial pose (RViz's /initialpose is rt/initialpose); empty: none read
+  std::string initialpose_topic;
   DdsSecuritySection security;
 };
 

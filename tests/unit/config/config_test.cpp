@@ -122,6 +122,26 @@ TEST(Config, ChoiceNotAllowed) {
   expect_single_error(r, "imu.source", 2, "'usb' is not one of: synthetic,serial,can");
 }
 
+TEST(Config, InitialPoseTopicDefaultsToRvizsAndMayBeEmptied) {
+  EXPECT_EQ(default_config().dds.initialpose_topic, "rt/initialpose");
+  const auto off = load("dds:\n  initialpose_topic: \"\"\n");
+  ASSERT_TRUE(off.ok()) << off.error_text();
+  EXPECT_EQ(off.config.dds.initialpose_topic, "");
+  const auto other = load("dds:\n  initialpose_topic: rt/robot_1/initialpose\n");
+  ASSERT_TRUE(other.ok()) << other.error_text();
+  EXPECT_EQ(other.config.dds.initialpose_topic, "rt/robot_1/initialpose");
+}
+
+TEST(Config, InitialPoseTopicMustBeADdsName) {
+  expect_single_error(load("dds:\n  domain_id: 3\n  initialpose_topic: /initialpose\n"),
+                      "dds.initialpose_topic", 3, "its DDS name is rt/initialpose");
+  for (const char* bad : {"initialpose", "rt/", "rt/initial pose", "rt//initialpose",
+                          "rt/initialpose/", "rt/1robot/initialpose"}) {
+    expect_single_error(load(std::string("dds:\n  initialpose_topic: \"") + bad + "\"\n"),
+                        "dds.initialpose_topic", 2, "is not a ROS 2 topic's DDS name");
+  }
+}
+
 TEST(Config, MatrixWrongSize) {
   const auto r = load("extrinsics:\n  T_imu_lidar: [1, 0, 0]\n");
   expect_single_error(r, "extrinsics.T_imu_lidar", 2, "expected a list of 16 numbers");
