@@ -20,6 +20,7 @@ int run_inspect(int argc, char** argv);
 int run_inspect_velodyne(int argc, char** argv);
 int run_inspect_camera(int argc, char** argv);
 int run_echo(int argc, char** argv);
+int run_initialpose(int argc, char** argv);
 int run_eval(int argc, char** argv);
 int run_sim(int argc, char** argv);
 int run_inspect_mcap(int argc, char** argv);
