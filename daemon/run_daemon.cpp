@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "daemon/build_info.hpp"
+#include "daemon/dds/initial_pose_reader.hpp"
 #include "daemon/dds/publisher.hpp"
 #include "daemon/extra_outputs.hpp"
 #include "daemon/notify/sd_notify.hpp"
@@ -123,6 +124,27 @@ std::shared_ptr<const mapping::KeyframeMap> load_prior_map(const std::string& di
   POSED_LOG_INFO("localising on %s: %zu keyframes, %zu points", dir.c_str(), map->keyframes.size(),
                  points);
   return map;
+}
+
+/// An initial pose from rt/initialpose, if one waits, to the localiser: only in the map frame
+/// (RViz's fixed frame must be the map's).
+void take_initial_pose(dds::InitialPoseReader& reader, pipeline::Pipeline& pipe,
+                       const std::string& map_frame) {
+  const std::optional<dds::InitialPose> pose = reader.take_newest();
+  if (!pose) return;
+  const Eigen::Vector3d p = pose->T_frame_base.translation();
+  if (pose->frame_id != map_frame) {
+    POSED_LOG_WARN(
+        "%s: initial pose in frame '%s' ignored: it must be in '%s' (set RViz's fixed "
+        "frame to it)",
+        reader.topic().c_str(), pose->frame_id.c_str(), map_frame.c_str());
+    return;
+  }
+  const Eigen::Vector3d heading = pose->T_frame_base.rotation().col(0);
+  POSED_LOG_NOTICE("%s: initial pose (%.2f, %.2f, %.2f) m, heading %.1f deg in %s",
+                   reader.topic().c_str(), p.x(), p.y(), p.z(),
+                   std::atan2(heading.y(), heading.x()) * 180.0 / M_PI, map_frame.c_str());
+  pipe.set_initial_pose(pose->T_frame_base);
 }
 
 /// How far the next --loop pass is shifted past the start of the last one: the span every
@@ -256,6 +278,19 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     if (!prior_map) return 1;
     built.sources.prior_map = prior_map;
   }
+  // Localising: RViz's 2D Pose Estimate (rt/initialpose) says where the robot is.
+  std::unique_ptr<dds::InitialPoseReader> initial_pose_reader;
+  if (prior_map && publisher && !dds_config.initial_pose_topic.empty()) {
+    initial_pose_reader = dds::InitialPoseReader::create(*publisher, dds_config, error);
+    if (!initial_pose_reader) {
+      // Not fatal: the map still localises by descriptor. A keystore made before posed read
+      // rt/initialpose does not permit it.
+      POSED_LOG_WARN(
+          "%s not read: %s (with DDS Security: remake the keystore with posectl "
+          "security init)",
+          dds_config.initial_pose_topic.c_str(), error.c_str());
+    }
+  }
   // Owned by the pipeline, which outlives every use below.
   const drivers::SyntheticImuSource* synthetic = built.synthetic;
 
@@ -367,6 +402,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
       siginfo_t info{};
       const int sig = sigtimedwait(&signals, &info, &poll_period);
       const HostTime now = drivers::host_now();
+      if (initial_pose_reader) take_initial_pose(*initial_pose_reader, *pipe, config.dds.map_frame);
       if (sig == SIGTERM || sig == SIGINT) {
         if (stopping) {
           POSED_LOG_ERROR("second %s: aborting without draining", strsignal(sig));

@@ -109,13 +109,13 @@ bool MappingStage::take(Item& item) {
       std::lock_guard lock(mutex_);
       initial.swap(initial_T_map_base_);
     }
+    const mapping::LocalisationState state_before = localiser_->state();
     if (initial) {
       localiser_->set_initial_pose(*initial);
       POSED_LOG_NOTICE("mapping: initial pose (%.2f, %.2f, %.2f) m in the map",
                        initial->translation().x(), initial->translation().y(),
                        initial->translation().z());
     }
-    const mapping::LocalisationState state_before = localiser_->state();
     const std::uint64_t fixes_before = localiser_->figures().fixes;
     if (item.has_scan) {
       localiser_->add_scan(item.stamp, item.T_odom_base, item.points_base);

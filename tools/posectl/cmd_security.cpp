@@ -43,8 +43,9 @@ int run_security(int argc, char** argv) {
   spec.dir = dir;
   spec.domain_id = domain_id;
   spec.valid_days = days;
-  spec.enclaves.push_back({"posed", kPosedTopics, {}});
-  spec.enclaves.push_back({"posectl", {}, kPosedTopics});
+  // posed reads one topic: the initial pose (RViz's 2D Pose Estimate, posectl initialpose).
+  spec.enclaves.push_back({"posed", kPosedTopics, {kInitialPoseTopic}});
+  spec.enclaves.push_back({"posectl", {kInitialPoseTopic}, kPosedTopics});
   for (const std::string& name : readers) {
     if (name.empty() || name.find_first_of("/. ") != std::string::npos) {
       std::fprintf(stderr, "posectl security init: --reader '%s': a plain name, no '/', '.', ' '\n",
@@ -62,9 +63,13 @@ int run_security(int argc, char** argv) {
               dir.c_str(),
               domain_id < 0 ? "every domain" : ("domain " + std::to_string(domain_id)).c_str());
   for (const EnclaveSpec& e : spec.enclaves) {
-    std::printf("  enclaves/%-10s %s %s\n", e.name.c_str(),
-                e.publish.empty() ? "reads" : "publishes",
-                "rt/posed/*, rt/tf, rt/tf_static, rt/diagnostics");
+    const auto list = [](const std::vector<std::string>& topics) {
+      std::string s;
+      for (const std::string& t : topics) s += (s.empty() ? "" : ", ") + t;
+      return s.empty() ? std::string("nothing") : s;
+    };
+    std::printf("  enclaves/%-10s publishes %s; reads %s\n", e.name.c_str(),
+                list(e.publish).c_str(), list(e.subscribe).c_str());
   }
   return 0;
 }

@@ -18,6 +18,9 @@ namespace posed::posectl {
 inline const std::vector<std::string> kPosedTopics = {"rt/posed/*", "rt/tf", "rt/tf_static",
                                                       "rt/diagnostics"};
 
+/// What posed reads: the initial pose for localisation on a saved map (RViz's 2D Pose Estimate).
+inline const std::string kInitialPoseTopic = "rt/initialpose";
+
 struct EnclaveSpec {
   std::string name;                  ///< "posed" -> enclaves/posed, subject CN=/posed
   std::vector<std::string> publish;  ///< DDS topic names or fnmatch patterns ("rt/posed/*")
