@@ -10,3 +10,5 @@ foreach(module IN LISTS _posed_pcl_modules)
   find_library(POSED_PCL_${module}_LIBRARY pcl_${module} REQUIRED)
   list(APPEND POSED_PCL_LIBRARIES ${POSED_PCL_${module}_LIBRARY})
 endforeach()
+# pcl_io for the tests only: that PCL's own reader opens the map files posed writes.
+find_library(POSED_PCL_io_LIBRARY pcl_io REQUIRED)
