@@ -199,6 +199,10 @@ void PoseSinks::status(const pipeline::PipelineStatus& st) {
                    f.selection.visual_inertial, f.selection.imu_only, f.selection.last_threshold_m};
   msg.uptime_s = (st.stamp - started_).seconds();
   msg.latency = {odom_latency_.message(live_clock_), pose_latency_.message(live_clock_)};
+  if (st.mapping) {  // else "off"
+    const pipeline::MappingStatus& m = *st.mapping;
+    msg.mapping = {m.state, m.keyframes, m.loops, m.fixes, m.correction_m, m.scans_skipped};
+  }
   std::string line = std::string(to_string(st.mode));
   for (const auto& s : st.streams) {
     dds::StreamStatusMessage m;

@@ -140,6 +140,13 @@ void fill_status(const StatusMessage& msg, posed_msgs_msg_dds__Status_& out,
     d.stamp_age_p99_ms = l.stamp_age_p99_ms;
     d.stamp_age_max_ms = l.stamp_age_max_ms;
   }
+  const MappingStatusMessage& mapping = msg.mapping;
+  out.mapping.state = c_str(mapping.state);
+  out.mapping.keyframes = mapping.keyframes;
+  out.mapping.loops = mapping.loops;
+  out.mapping.fixes = mapping.fixes;
+  out.mapping.correction_m = mapping.correction_m;
+  out.mapping.scans_skipped = mapping.scans_skipped;
   out.streams._buffer = streams.data();
   out.streams._length = static_cast<std::uint32_t>(msg.streams.size());
   out.streams._maximum = static_cast<std::uint32_t>(streams.size());
@@ -423,6 +430,13 @@ StatusMessage to_plain(const posed_msgs_msg_dds__Status_& in) {
     d.stamp_age_p99_ms = l.stamp_age_p99_ms;
     d.stamp_age_max_ms = l.stamp_age_max_ms;
   }
+  MappingStatusMessage& mapping = msg.mapping;
+  mapping.state = to_string(in.mapping.state);
+  mapping.keyframes = in.mapping.keyframes;
+  mapping.loops = in.mapping.loops;
+  mapping.fixes = in.mapping.fixes;
+  mapping.correction_m = in.mapping.correction_m;
+  mapping.scans_skipped = in.mapping.scans_skipped;
   return msg;
 }
 

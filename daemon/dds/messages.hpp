@@ -329,6 +329,17 @@ struct TopicLatencyMessage {
   double stamp_age_p50_ms = 0, stamp_age_p99_ms = 0, stamp_age_max_ms = 0;
 };
 
+/// posed_msgs/MappingStatus: the mapping stage's figures.
+struct MappingStatusMessage {
+  /// "off" (no mapping stage), "mapping", or localising: "aligning", "localised", "lost"
+  std::string state = "off";
+  std::uint64_t keyframes = 0;      ///< closing loops: in the pose graph [count]
+  std::uint64_t loops = 0;          ///< closing loops: accepted [count]
+  std::uint64_t fixes = 0;          ///< localising: verified registrations onto the map [count]
+  double correction_m = 0;          ///< map -> odom's translation [m]
+  std::uint64_t scans_skipped = 0;  ///< live: kept from the stage by its full queue [count]
+};
+
 /// posed_msgs/Status: published at 1 Hz.
 struct StatusMessage {
   /// time of the report (wall clock, UNIX epoch) [ns]
@@ -352,6 +363,7 @@ struct StatusMessage {
   std::vector<StreamStatusMessage> streams;
   /// rt/posed/odom, rt/posed/pose
   std::array<TopicLatencyMessage, 2> latency{};
+  MappingStatusMessage mapping;
 };
 
 /// DDS Security (OMG DDS Security 1.1 with Cyclone DDS's builtin plugins): the six files of a

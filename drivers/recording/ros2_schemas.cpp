@@ -174,7 +174,8 @@ std::string_view posed_status_schema() {
             "float64 uptime_s\n"
             "string summary\n"
             "StreamStatus[] streams\n"
-            "TopicLatency[2] latency\n",
+            "TopicLatency[2] latency\n"
+            "MappingStatus mapping\n",
             kHeaderDef, kTimeDef,
             "MSG: posed_msgs/EstimatorStatus\n"
             "uint64 scans_used\n"
@@ -238,7 +239,14 @@ std::string_view posed_status_schema() {
             "float64 receive_to_write_max_ms\n"
             "float64 stamp_age_p50_ms\n"
             "float64 stamp_age_p99_ms\n"
-            "float64 stamp_age_max_ms\n"});
+            "float64 stamp_age_max_ms\n",
+            "MSG: posed_msgs/MappingStatus\n"
+            "string state\n"
+            "uint64 keyframes\n"
+            "uint64 loops\n"
+            "uint64 fixes\n"
+            "float64 correction_m\n"
+            "uint64 scans_skipped\n"});
   return s;
 }
 

@@ -339,6 +339,8 @@ TEST_F(CdrLoop, StatusRoundTripsWithStreams) {
   in.camera.omega[0] = 80.5;
   in.uptime_s = 3600.25;
   in.summary = summary;
+  char lost[] = "lost";
+  in.mapping = {lost, 0, 0, 21, 0.5, 7};
   in.streams._buffer = streams;
   in.streams._length = 2;
   in.streams._maximum = 2;
@@ -355,6 +357,10 @@ TEST_F(CdrLoop, StatusRoundTripsWithStreams) {
   EXPECT_EQ(out.camera.omega[0], 80.5);
   EXPECT_EQ(out.uptime_s, 3600.25);
   EXPECT_STREQ(out.summary, "2 streams");
+  EXPECT_STREQ(out.mapping.state, "lost");
+  EXPECT_EQ(out.mapping.fixes, 21u);
+  EXPECT_EQ(out.mapping.correction_m, 0.5);
+  EXPECT_EQ(out.mapping.scans_skipped, 7u);
   ASSERT_EQ(out.streams._length, 2u);
   expect_stream_eq(out.streams._buffer[0], streams[0]);
   expect_stream_eq(out.streams._buffer[1], streams[1]);
@@ -454,6 +460,44 @@ std::vector<unsigned char> unpadded(std::vector<unsigned char> bytes) {
   bytes.erase(bytes.end() - padding, bytes.end());
   bytes[2] = bytes[3] = 0;
   return bytes;
+}
+
+// The status's last member is the mapping stage's, laid out as the ros2msg schema says (string
+// state, uint64 keyframes, loops, fixes, float64 correction_m, uint64 scans_skipped), with
+// nothing after it: a reader of an older layout still finds every field before it where it was.
+TEST_F(CdrLoop, StatusEndsWithTheMappingStatusAsItsSchemaSays) {
+  StatusMessage msg;
+  msg.stamp = WallTime::from_ns(5'000'000'000);
+  msg.version = "posed 0.1.0";
+  msg.summary = "x";
+  msg.streams.resize(1);
+  msg.mapping = {"localised", 12, 3, 45, 6.75, 8};
+  posed_msgs_msg_dds__Status_ in{};
+  std::vector<posed_msgs_msg_dds__StreamStatus_> streams;
+  detail::fill_status(msg, in, streams);
+  char map[] = "map";
+  in.header.frame_id = map;
+  posed_msgs_msg_dds__Status_ out{};
+  const auto wire = unpadded(round_trip(posed_msgs_msg_dds__Status__desc, in, out));
+  free_sample(posed_msgs_msg_dds__Status__desc, out);
+  std::vector<std::byte> tapped;
+  detail::encode_cdr(Topic::kStatus, &in, tapped);
+  ASSERT_EQ(tapped.size(), wire.size());
+  EXPECT_EQ(std::memcmp(tapped.data(), wire.data(), wire.size()), 0);
+
+  // The mapping member starts at the state string's length, the last one like it in the message.
+  const unsigned char state[] = {10, 0, 0, 0, 'l', 'o', 'c', 'a', 'l', 'i', 's', 'e', 'd', 0};
+  const auto at = std::find_end(wire.begin(), wire.end(), std::begin(state), std::end(state));
+  ASSERT_NE(at, wire.end());
+  CdrBuilder expected;
+  expected.bytes.assign(wire.begin(), at);
+  expected.put_string("localised");
+  expected.put<std::uint64_t>(12);
+  expected.put<std::uint64_t>(3);
+  expected.put<std::uint64_t>(45);
+  expected.put<double>(6.75);
+  expected.put<std::uint64_t>(8);
+  EXPECT_EQ(wire, expected.bytes);
 }
 
 TEST_F(CdrLoop, PointCloud2BytesMatchRos2Layout) {

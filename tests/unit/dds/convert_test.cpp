@@ -100,6 +100,7 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   msg.visual[0].keyframe_factors = 31;
   msg.visual[0].still = 7;
   msg.visual[0].residual_median = 1.5;
+  msg.mapping = {"localised", 120, 3, 17, 2.25, 4};
   for (const char* name : {"imu", "lidar", "color"}) {
     StreamStatusMessage s;
     s.name = name;
@@ -150,6 +151,13 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   EXPECT_EQ(back.camera.omega, msg.camera.omega);
   EXPECT_EQ(back.uptime_s, msg.uptime_s);
   EXPECT_EQ(back.summary, msg.summary);
+  EXPECT_EQ(c.mapping.state, msg.mapping.state.c_str());  // points into msg, no copy
+  EXPECT_EQ(back.mapping.state, "localised");
+  EXPECT_EQ(back.mapping.keyframes, 120u);
+  EXPECT_EQ(back.mapping.loops, 3u);
+  EXPECT_EQ(back.mapping.fixes, 17u);
+  EXPECT_EQ(back.mapping.correction_m, 2.25);
+  EXPECT_EQ(back.mapping.scans_skipped, 4u);
   ASSERT_EQ(back.streams.size(), 3u);
   EXPECT_EQ(back.streams[1].name, "lidar");
   EXPECT_EQ(back.streams[2].clock_offset_ns, -5);
@@ -160,6 +168,19 @@ TEST(DdsConvert, StatusReusesStreamBufferAndRoundTrips) {
   EXPECT_EQ(buffer.size(), 10u);
   EXPECT_EQ(c.streams._length, 10u);
   EXPECT_EQ(c.streams._buffer, buffer.data());
+}
+
+// Without a mapping stage the status says so rather than leaving the state empty.
+TEST(DdsConvert, StatusWithoutAMappingStageSaysOff) {
+  const StatusMessage msg;
+  std::vector<posed_msgs_msg_dds__StreamStatus_> buffer;
+  posed_msgs_msg_dds__Status_ c{};
+  detail::fill_status(msg, c, buffer);
+  EXPECT_STREQ(c.mapping.state, "off");
+  const StatusMessage back = detail::to_plain(c);
+  EXPECT_EQ(back.mapping.state, "off");
+  EXPECT_EQ(back.mapping.keyframes, 0u);
+  EXPECT_EQ(back.mapping.correction_m, 0.0);
 }
 
 }  // namespace

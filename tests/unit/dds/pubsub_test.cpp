@@ -112,6 +112,7 @@ TEST_F(DdsPubSub, StatusArrivesWithEveryStream) {
   msg.estimator_mode = "strapdown";
   msg.uptime_s = 61.5;
   msg.summary = "imu ok, lidar stale";
+  msg.mapping = {"mapping", 412, 9, 0, 31.5, 2};
   for (int i = 0; i < 12; ++i) {  // more than the preallocated 8: the buffer must grow
     StreamStatusMessage s;
     s.name = "stream" + std::to_string(i);
@@ -138,6 +139,12 @@ TEST_F(DdsPubSub, StatusArrivesWithEveryStream) {
   EXPECT_EQ(r.estimator_mode, msg.estimator_mode);
   EXPECT_EQ(r.uptime_s, msg.uptime_s);
   EXPECT_EQ(r.summary, msg.summary);
+  EXPECT_EQ(r.mapping.state, "mapping");
+  EXPECT_EQ(r.mapping.keyframes, 412u);
+  EXPECT_EQ(r.mapping.loops, 9u);
+  EXPECT_EQ(r.mapping.fixes, 0u);
+  EXPECT_EQ(r.mapping.correction_m, 31.5);
+  EXPECT_EQ(r.mapping.scans_skipped, 2u);
   ASSERT_EQ(r.streams.size(), msg.streams.size());
   for (std::size_t i = 0; i < r.streams.size(); ++i) {
     EXPECT_EQ(r.streams[i].name, msg.streams[i].name);
