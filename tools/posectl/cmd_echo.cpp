@@ -402,6 +402,17 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
         static_cast<unsigned long long>(sel.visual_inertial),
         static_cast<unsigned long long>(sel.imu_only), sel.threshold_m);
   }
+  const dds::MappingStatusMessage& map = m.mapping;
+  if (map.state == "off") {
+    std::printf("  mapping    off\n");
+  } else {
+    std::printf(
+        "  mapping    state %s  keyframes %llu loops %llu fixes %llu  map -> odom %.3f m  scans "
+        "skipped %llu\n",
+        map.state.c_str(), static_cast<unsigned long long>(map.keyframes),
+        static_cast<unsigned long long>(map.loops), static_cast<unsigned long long>(map.fixes),
+        map.correction_m, static_cast<unsigned long long>(map.scans_skipped));
+  }
   for (const auto& s : m.streams) {
     std::printf(
         "  %-10s %8.2f Hz  received %llu decoded %llu dropped %llu malformed %llu  clock %s: "
