@@ -96,6 +96,7 @@ TEST(Daemon, PublishesOdomThatFollowsTheKnownMotionAndStopsOnSigterm) {
   ASSERT_EQ(status.back().msg.streams.size(), 1u);
   EXPECT_EQ(status.back().msg.streams[0].name, "imu");
   EXPECT_EQ(status.back().msg.streams[0].health, "ok");
+  EXPECT_EQ(status.back().msg.mapping.state, "off");  // no lidar, no mapping stage
 
   const auto t0 = std::chrono::steady_clock::now();
   posed.signal(SIGTERM);

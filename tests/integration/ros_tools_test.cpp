@@ -295,6 +295,8 @@ TEST(Ros2Tools, FoxglovesOwnClientGetsAndDecodesEveryTopic) {
   EXPECT_EQ(cloud["dataBytes"].get<long long>(), cloud["width"].get<long long>() * 22);
   EXPECT_EQ(channels["/posed/map"]["last"]["frameId"], "odom");
   EXPECT_EQ(channels["/diagnostics"]["last"]["statuses"][0], "posed: imu");
+  // The status's last member, decoded with the schema: a field out of place would garble it.
+  EXPECT_EQ(channels["/posed/status"]["last"]["mappingState"], "mapping");
 }
 
 TEST(Ros2Tools, TheFrontEndsImageArrivesAsAJpegOfTheTrackedImage) {

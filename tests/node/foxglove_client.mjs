@@ -15,7 +15,8 @@
 // --decode parses each ros2msg schema with @foxglove/rosmsg and decodes every message with
 // @foxglove/rosmsg2-serialization, as Foxglove Studio does: per channel "decoded" and
 // "decodeErrors" (with the first error), and "last" holding a few fields of the newest message
-// (header.frame_id; a PointCloud2's width, point_step and field names; a TFMessage's frames).
+// (header.frame_id; a PointCloud2's width, point_step and field names; a TFMessage's frames; a
+// Status's mapping.state).
 // --until-close reports when the server closes the connection (the end of a replay) and exits
 // 0, instead of treating it as a failure.
 //
@@ -62,6 +63,7 @@ function summarize(message) {
   }
   if (Array.isArray(message?.poses)) out.poses = message.poses.length;
   if (Array.isArray(message?.status)) out.statuses = message.status.map((d) => d.name);
+  if (message?.mapping?.state !== undefined) out.mappingState = message.mapping.state;
   return out;
 }
 
