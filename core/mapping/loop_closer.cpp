@@ -21,16 +21,17 @@ LoopCloser::LoopCloser(LoopClosureConfig config)
       selector_(config_.keyframe_distance_m, config_.keyframe_angle_rad) {}
 
 bool LoopCloser::add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
-                     std::span<const Eigen::Vector3f> points_base) {
+                     std::span<const Eigen::Vector3f> points_base, double degenerate_share) {
   if (!selector_.take(T_odom_base)) {
     return false;
   }
-  add_keyframe(stamp, T_odom_base, points_base);
+  add_keyframe(stamp, T_odom_base, points_base, degenerate_share);
   return true;
 }
 
 void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
-                              std::span<const Eigen::Vector3f> points_base) {
+                              std::span<const Eigen::Vector3f> points_base,
+                              double degenerate_share) {
   DescribedScan described =
       describe_scan(points_base, T_odom_base.rotation(), config_.keyframe_max_range_m,
                     config_.keyframe_voxel_m, config_.scan_context);
@@ -51,10 +52,15 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
     edge.to = index;
     edge.T_from_to = last.T_odom_base.inverse() * T_odom_base;
     const double d = edge.T_from_to.translation().norm();
-    edge.sigma_translation_m =
-        config_.odometry_sigma_translation_m + config_.odometry_sigma_translation_per_m * d;
-    edge.sigma_rotation_rad =
-        config_.odometry_sigma_rotation_rad + config_.odometry_sigma_rotation_per_m * d;
+    const double share = std::clamp(degenerate_share, 0.0, 1.0);
+    edge.sigma_translation_m = config_.odometry_sigma_translation_m +
+                               (config_.odometry_sigma_translation_per_m +
+                                share * config_.odometry_sigma_translation_degenerate_per_m) *
+                                   d;
+    edge.sigma_rotation_rad = config_.odometry_sigma_rotation_rad +
+                              (config_.odometry_sigma_rotation_per_m +
+                               share * config_.odometry_sigma_rotation_degenerate_per_m) *
+                                  d;
     graph_.add_edge(edge);
   }
   keyframes_.push_back(std::move(kf));

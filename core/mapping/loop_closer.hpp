@@ -58,6 +58,11 @@ struct LoopClosureConfig {
   double odometry_sigma_translation_per_m = 0.01;
   double odometry_sigma_rotation_rad = 0.001;
   double odometry_sigma_rotation_per_m = 0.001;
+  /// added per metre when the estimator called the scans between two keyframes degenerate
+  /// (scaled by their share): lidar odometry drifts where geometry is poor (an open stretch), so a
+  /// loop's correction belongs there rather than spread over the whole lap [m/m], [rad/m]
+  double odometry_sigma_translation_degenerate_per_m = 0.0;
+  double odometry_sigma_rotation_degenerate_per_m = 0.0;
   double loop_sigma_translation_m = 0.05;
   double loop_sigma_rotation_rad = 0.01;
   /// Cauchy scale on loop edges [sigma]; 0: none. Off by default: a true loop after long drift
@@ -100,11 +105,13 @@ class LoopCloser {
   /// `stamp`). Returns true when it became a keyframe (KeyframeSelector with the config's
   /// distance and angle). Poses must come in stamp order.
   bool add(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
-           std::span<const Eigen::Vector3f> points_base);
+           std::span<const Eigen::Vector3f> points_base, double degenerate_share = 0.0);
   /// A pose a KeyframeSelector with the config's distance and angle already chose (the daemon
   /// selects on the fusion thread and copies only those scans): becomes a keyframe.
+  /// `degenerate_share`: of the scans since the last keyframe, those whose match the estimator
+  /// found degenerate [0..1]; it widens the odometry edge from the last keyframe.
   void add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
-                    std::span<const Eigen::Vector3f> points_base);
+                    std::span<const Eigen::Vector3f> points_base, double degenerate_share = 0.0);
 
   const LoopClosureConfig& config() const { return config_; }
   /// The correction from the odometry frame onto the optimised map.

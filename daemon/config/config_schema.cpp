@@ -555,6 +555,10 @@ const Field kSchema[] = {
     F("mapping.queue_capacity", mapping.queue_capacity, "64", "scans", 4, 4096, "",
       "scans waiting for the mapping thread; live, a keyframe that finds it full is left out "
       "(counted; the graph bridges it by odometry), a replay waits"),
+    F("mapping.degenerate_sigma_per_m", mapping.degenerate_sigma_per_m, "0.5", "m/m", 0, 10, "",
+      "an odometry edge of the pose graph is this much less certain per metre the estimator "
+      "matched degenerately (an open stretch), so loops correct the drift there; rotation gets a "
+      "tenth of it in rad/m"),
     F("mapping.localise_every_m", mapping.localise_every_m, "2", "m", 0.1, 100, "",
       "localising on a prior map (posed --map): once localised, register the scan onto the map "
       "after moving this far"),

@@ -290,6 +290,8 @@ struct MappingSection {
   double min_overlap = 0.5;                 ///< and its overlap at least [0..1]
   double min_constraint = 0.02;  ///< and its weakest direction's information share [0..1]
   int queue_capacity = 64;       ///< scans waiting for the mapping thread (live) [1]
+  /// odometry edges between keyframes widen by this per metre of degenerate matching [m/m]
+  double degenerate_sigma_per_m = 0.5;
   // Localisation on a prior map (posed --map DIR).
   double localise_every_m = 2.0;  ///< localised: a registration onto the map this often [m]
   double lost_after_m = 25.0;     ///< travel without a verified fix after which it is lost [m]

@@ -92,6 +92,8 @@ mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config
   c.registration.max_rms_m = m.max_rms_m;
   c.registration.min_overlap = m.min_overlap;
   c.registration.min_constraint = m.min_constraint;
+  c.odometry_sigma_translation_degenerate_per_m = m.degenerate_sigma_per_m;
+  c.odometry_sigma_rotation_degenerate_per_m = 0.1 * m.degenerate_sigma_per_m;
   return c;
 }
 

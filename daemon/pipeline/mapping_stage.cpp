@@ -1,5 +1,7 @@
 #include "daemon/pipeline/mapping_stage.hpp"
 
+#include <algorithm>
+
 #include "daemon/pipeline/estimator_config.hpp"
 #include "daemon/pipeline/thread_policy.hpp"
 #include "drivers/common/log.hpp"
@@ -40,6 +42,15 @@ void MappingStage::after_scan(const FusionCore& core) {
     // Localising needs every scan: while aligning each is a lookup.
     if (localiser_ || selector_.take(T_odom_base)) {
       item.has_scan = true;
+      // How much of the odometry since the last keyframe ran on degenerate matches.
+      const FusionFigures f = core.figures();
+      const std::uint64_t used = f.scans_used - used_at_keyframe_;
+      const std::uint64_t degenerate = f.scans_degenerate - degenerate_at_keyframe_;
+      item.degenerate_share =
+          used > 0 ? std::min(1.0, static_cast<double>(degenerate) / static_cast<double>(used))
+                   : 0.0;
+      used_at_keyframe_ = f.scans_used;
+      degenerate_at_keyframe_ = f.scans_degenerate;
       item.stamp = scan.stamp;
       item.T_odom_base = T_odom_base;
       item.points_base.reserve(scan.points_lidar.size());
@@ -146,7 +157,7 @@ bool MappingStage::take(Item& item) {
   }
   const std::size_t loops_before = closer_.loops().size();
   if (item.has_scan) {
-    closer_.add_keyframe(item.stamp, item.T_odom_base, item.points_base);
+    closer_.add_keyframe(item.stamp, item.T_odom_base, item.points_base, item.degenerate_share);
   }
   const std::size_t loops_now = closer_.loops().size();
   {

@@ -85,6 +85,7 @@ class MappingStage final : public ScanObserver {
     HostTime stamp;
     Eigen::Isometry3d T_odom_base = Eigen::Isometry3d::Identity();
     std::vector<Eigen::Vector3f> points_base;
+    double degenerate_share = 0;  ///< of the scans used since the last keyframe [0..1]
   };
   void push(Item item);
   /// The stage's thread: one scan into the localiser or loop closer; true when map -> odom
@@ -100,6 +101,8 @@ class MappingStage final : public ScanObserver {
   // Fusion thread only.
   mapping::KeyframeSelector selector_;
   std::uint64_t last_scan_index_ = 0;
+  std::uint64_t used_at_keyframe_ = 0;        ///< FusionFigures::scans_used at the last keyframe
+  std::uint64_t degenerate_at_keyframe_ = 0;  ///< and scans_degenerate
 
   mutable std::mutex mutex_;
   std::condition_variable item_ready_;  ///< the stage's thread waits for items
