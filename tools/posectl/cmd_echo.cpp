@@ -323,7 +323,8 @@ void print_status_header_csv() {
   std::printf(
       "stamp_s,receive_s,latency_ms,version,estimator_mode,uptime_s,summary,stream,rate_hz,"
       "received,decoded,dropped,malformed,clock_offset_ns,clock_drift_ppm,clock_jitter_ns,"
-      "clock_uncertainty_ns,clock_state,health\n");
+      "clock_uncertainty_ns,clock_state,health,mapping_state,mapping_keyframes,mapping_loops,"
+      "mapping_fixes,mapping_correction_m\n");
 }
 
 void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
@@ -335,15 +336,21 @@ void print_status(const dds::Received<dds::StatusMessage>& r, bool as_csv) {
                                std::to_string(lat) + "," + csv(m.version) + "," +
                                csv(m.estimator_mode) + "," + std::to_string(m.uptime_s) + "," +
                                csv(m.summary);
-    if (m.streams.empty()) std::printf("%s,,,,,,,,,,,,\n", prefix.c_str());
+    // The mapping stage's figures end every row.
+    char mapping[160];
+    std::snprintf(mapping, sizeof mapping, "%s,%llu,%llu,%llu,%.3f", csv(m.mapping.state).c_str(),
+                  static_cast<unsigned long long>(m.mapping.keyframes),
+                  static_cast<unsigned long long>(m.mapping.loops),
+                  static_cast<unsigned long long>(m.mapping.fixes), m.mapping.correction_m);
+    if (m.streams.empty()) std::printf("%s,,,,,,,,,,,,,%s\n", prefix.c_str(), mapping);
     for (const auto& s : m.streams) {
-      std::printf("%s,%s,%.3f,%llu,%llu,%llu,%llu,%lld,%.3f,%.1f,%.1f,%s,%s\n", prefix.c_str(),
-                  csv(s.name).c_str(), s.rate_hz, static_cast<unsigned long long>(s.received),
-                  static_cast<unsigned long long>(s.decoded),
-                  static_cast<unsigned long long>(s.dropped),
-                  static_cast<unsigned long long>(s.malformed),
-                  static_cast<long long>(s.clock_offset_ns), s.clock_drift_ppm, s.clock_jitter_ns,
-                  s.clock_uncertainty_ns, csv(s.clock_state).c_str(), csv(s.health).c_str());
+      std::printf(
+          "%s,%s,%.3f,%llu,%llu,%llu,%llu,%lld,%.3f,%.1f,%.1f,%s,%s,%s\n", prefix.c_str(),
+          csv(s.name).c_str(), s.rate_hz, static_cast<unsigned long long>(s.received),
+          static_cast<unsigned long long>(s.decoded), static_cast<unsigned long long>(s.dropped),
+          static_cast<unsigned long long>(s.malformed), static_cast<long long>(s.clock_offset_ns),
+          s.clock_drift_ppm, s.clock_jitter_ns, s.clock_uncertainty_ns, csv(s.clock_state).c_str(),
+          csv(s.health).c_str(), mapping);
     }
     return;
   }

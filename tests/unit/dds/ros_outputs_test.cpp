@@ -59,6 +59,44 @@ TEST(RosDiagnostics, StreamHealthBecomesRosLevelsWithFigures) {
   EXPECT_EQ(diagnostics(st, WallTime::from_ns(1)).status[4].level, L::kWarn);
 }
 
+TEST(RosDiagnostics, TheMappingStageIsAWarningUntilLocalised) {
+  pipeline::PipelineStatus st;
+  using L = dds::DiagnosticStatusMessage;
+  // No mapping stage: no mapping status.
+  ASSERT_EQ(diagnostics(st, WallTime::from_ns(1)).status.size(), 1u);
+  pipeline::MappingStatus& m = st.mapping.emplace();
+  m.localising = true;
+  m.state = "aligning";
+  m.correction_m = 12.5;
+  const dds::DiagnosticsMessage aligning = diagnostics(st, WallTime::from_ns(1));
+  ASSERT_EQ(aligning.status.size(), 2u);
+  const L& d = aligning.status[1];
+  EXPECT_EQ(d.name, "posed: mapping");
+  EXPECT_EQ(d.level, L::kWarn);
+  EXPECT_EQ(d.message, "aligning");
+  EXPECT_NE(std::find(d.values.begin(), d.values.end(),
+                      std::pair<std::string, std::string>{"map -> odom", "12.500 m"}),
+            d.values.end());
+  m.state = "localised";
+  m.fixes = 3;
+  const L localised = diagnostics(st, WallTime::from_ns(1)).status[1];
+  EXPECT_EQ(localised.level, L::kOk);
+  EXPECT_NE(std::find(localised.values.begin(), localised.values.end(),
+                      std::pair<std::string, std::string>{"fixes", "3"}),
+            localised.values.end());
+  m.state = "lost";
+  EXPECT_EQ(diagnostics(st, WallTime::from_ns(1)).status[1].level, L::kWarn);
+  // Closing loops is never a warning by itself.
+  m.localising = false;
+  m.state = "mapping";
+  m.loops = 4;
+  const L mapping = diagnostics(st, WallTime::from_ns(1)).status[1];
+  EXPECT_EQ(mapping.level, L::kOk);
+  EXPECT_NE(std::find(mapping.values.begin(), mapping.values.end(),
+                      std::pair<std::string, std::string>{"loops", "4"}),
+            mapping.values.end());
+}
+
 TEST(RosStaticTransforms, ThermalIsTheCameraExtrinsicChainedWithCameraToThermal) {
   config::PosedConfig config;
   config.dds.base_frame = "base_link";
