@@ -157,6 +157,7 @@ bool Recorder::push(std::uint16_t id, std::int64_t log_time_ns, std::vector<std:
   const std::uint64_t order = push_order_.fetch_add(1, std::memory_order_relaxed);
   const PushResult r = c.queue.push(Item{log_time_ns, order, std::move(bytes)});
   if (r != PushResult::kPushed) return false;
+  if (options_.in_push_order) pushed_before_.store(order + 1, std::memory_order_release);
   c.bytes.store(c.bytes.load(std::memory_order_relaxed) + size, std::memory_order_relaxed);
   return true;
 }
@@ -212,8 +213,12 @@ void Recorder::run() {
     std::vector<std::byte> bytes;
   };
   std::vector<Pending> batch;
+  // in_push_order: items a pass took that were pushed after it began, for the next pass
+  std::vector<Pending> held;
   HostTime last_flush = host_now();
   for (;;) {
+    // Before draining: everything pushed before this is in the queues (one producer).
+    const std::uint64_t pushed_before = pushed_before_.load(std::memory_order_acquire);
     // Read the flag before draining: whatever was queued before stop is drained below.
     const bool stopping = !running_.load(std::memory_order_acquire);
     // Drain only channels whose record is in the file: one added since register_channels() read
@@ -224,7 +229,26 @@ void Recorder::run() {
       n = registered_in_file_;
     }
     batch.clear();
-    for (std::size_t i = 0; i < n; ++i) {
+    if (options_.in_push_order) {
+      // What an earlier pass took early, then every queue to the end: the pass writes exactly
+      // the items pushed before it began, whatever the producer did meanwhile.
+      std::vector<Pending> later;
+      for (Pending& p : held) {
+        (p.order < pushed_before ? batch : later).push_back(std::move(p));
+      }
+      held.swap(later);
+      for (std::size_t i = 0; i < n; ++i) {
+        Item item;
+        while (channels_[i]->queue.try_pop(item)) {
+          Pending p{item.log_time_ns, item.order, static_cast<std::uint16_t>(i),
+                    std::move(item.bytes)};
+          (p.order < pushed_before ? batch : held).push_back(std::move(p));
+        }
+      }
+      std::sort(batch.begin(), batch.end(),
+                [](const Pending& a, const Pending& b) { return a.order < b.order; });
+    }
+    for (std::size_t i = 0; i < n && !options_.in_push_order; ++i) {
       Item item;
       // Bounded per pass so one busy channel cannot starve the merge order of the others.
       for (int k = 0; k < 4096 && channels_[i]->queue.try_pop(item); ++k) {
@@ -236,9 +260,11 @@ void Recorder::run() {
     // time order across channels (MCAP does not require it; players prefer it). Equal log times
     // keep the order they were pushed in: a Source's chunks of one read (a D435i frame's metadata,
     // then the frame) must replay in that order whatever channel each went to.
-    std::sort(batch.begin(), batch.end(), [](const Pending& a, const Pending& b) {
-      return a.log_time_ns != b.log_time_ns ? a.log_time_ns < b.log_time_ns : a.order < b.order;
-    });
+    if (!options_.in_push_order) {
+      std::sort(batch.begin(), batch.end(), [](const Pending& a, const Pending& b) {
+        return a.log_time_ns != b.log_time_ns ? a.log_time_ns < b.log_time_ns : a.order < b.order;
+      });
+    }
     for (auto& p : batch) {
       if (!writer_.is_open()) {
         write_errors_.fetch_add(1, std::memory_order_relaxed);
@@ -274,7 +300,7 @@ void Recorder::run() {
       last_flush = now;
     }
     if (batch.empty()) {
-      if (stopping) break;
+      if (stopping && held.empty()) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   }

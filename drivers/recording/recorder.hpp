@@ -49,6 +49,11 @@ struct RecorderOptions {
   /// close the open chunk at least this often, so slow streams reach the disk (host clock);
   /// 0 = only when full, so the file's bytes depend on what was recorded alone, not on when
   Duration flush_interval = Duration::from_ms(1000);
+  /// one producer thread whose push order is the file's message order (posectl sim): each pass
+  /// of the writer thread takes only what was pushed before it began, in push order, so the
+  /// file does not depend on how the threads were scheduled. Live recordings (several producers)
+  /// keep false: each pass is ordered by log time.
+  bool in_push_order = false;
   /// wall minus host time; when unset (0) it is sampled once in open()
   HostToWall host_to_wall{Duration::from_ns(0)};
   /// further Metadata records (name -> entries) written at the start of every file, e.g. how a
@@ -169,6 +174,8 @@ class Recorder {
   std::array<std::unique_ptr<Channel>, kMaxChannels> channels_;
   std::atomic<std::size_t> channel_count_{0};
   std::atomic<std::uint64_t> push_order_{0};
+  /// in_push_order: one past the order of the newest item in a queue (one producer)
+  std::atomic<std::uint64_t> pushed_before_{0};
   mutable std::mutex mutex_;  // channel registration, topic lookup, files_, error_
   std::map<std::string, std::uint16_t, std::less<>> pose_topics_;
   std::vector<std::string> files_;

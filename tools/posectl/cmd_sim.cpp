@@ -231,6 +231,9 @@ int run_sim(int argc, char** argv) {
   // Chunks close when full, never on the writer thread's clock: the same seed writes the same
   // file, byte for byte.
   ropt.flush_interval = Duration::from_ns(0);
+  // And messages go into the file in the order the simulator made them, not in the order the
+  // writer thread happened to drain its queues.
+  ropt.in_push_order = true;
   // How the run was made, so tools can rebuild its world (posectl inspect frontend measures
   // lidar depth against it) and a person can reproduce it.
   ropt.metadata[std::string(sim::kSimMetadataName)] = {
