@@ -9,11 +9,10 @@ namespace posed::lidar {
 VoxelMap::VoxelMap(const VoxelMapConfig& config)
     : config_(config),
       inv_voxel_(static_cast<float>(1.0 / config.voxel_m)),
+      cap_(static_cast<std::size_t>(std::max(config.max_points_per_voxel, 1))),
       confirm_s_(static_cast<float>(config.confirm_after_s)),
       confirm_radius_m_(
-          static_cast<float>(std::max(config.min_point_distance_m, 0.5 * config.voxel_m))) {
-  index_.reserve(1 << 16);
-}
+          static_cast<float>(std::max(config.min_point_distance_m, 0.5 * config.voxel_m))) {}
 
 Eigen::Vector3i VoxelMap::voxel_of(const Eigen::Vector3f& p) const {
   return {static_cast<int>(std::floor(p.x() * inv_voxel_)),
@@ -28,6 +27,23 @@ std::uint64_t VoxelMap::key_of(const Eigen::Vector3i& v) const {
   return (axis(v.x()) << 42) | (axis(v.y()) << 21) | axis(v.z());
 }
 
+std::uint32_t VoxelMap::slot_for(std::uint64_t key) {
+  auto [slot, inserted] = index_.try_emplace(key);
+  if (!inserted) return *slot;
+  if (!free_.empty()) {
+    *slot = free_.back();
+    free_.pop_back();
+  } else {
+    *slot = static_cast<std::uint32_t>(slot_key_.size());
+    slot_key_.push_back(key);
+    slot_count_.push_back(0);
+    pool_.resize(pool_.size() + cap_);
+    if (confirm_s_ > 0) first_seen_s_.resize(pool_.size());
+  }
+  slot_key_[*slot] = key;
+  return *slot;
+}
+
 void VoxelMap::insert(const std::vector<Eigen::Vector3f>& points_map, std::int64_t stamp_ns) {
   if (!started_) {
     started_ = true;
@@ -40,51 +56,40 @@ void VoxelMap::insert(const std::vector<Eigen::Vector3f>& points_map, std::int64
   const float min_d2 =
       static_cast<float>(config_.min_point_distance_m * config_.min_point_distance_m);
   const float confirm_d2 = confirm_radius_m_ * confirm_radius_m_;
-  const auto cap = static_cast<std::size_t>(config_.max_points_per_voxel);
   for (const Eigen::Vector3f& p : points_map) {
-    const std::uint64_t key = key_of(voxel_of(p));
-    auto [it, inserted] = index_.try_emplace(key, 0u);
-    if (inserted) {
-      if (!free_.empty()) {
-        it->second = free_.back();
-        free_.pop_back();
-      } else {
-        it->second = static_cast<std::uint32_t>(voxels_.size());
-        voxels_.emplace_back();
-        voxels_.back().points.reserve(cap);
-        if (confirm_s_ > 0) voxels_.back().first_seen_s.reserve(cap);
-      }
-    }
-    Voxel& voxel = voxels_[it->second];
-    std::vector<Eigen::Vector3f>& v = voxel.points;
-    if (confirm_s_ <= 0 && v.size() >= cap) continue;  // full, and nothing to confirm
+    const std::uint32_t slot = slot_for(key_of(voxel_of(p)));
+    std::uint32_t& count = slot_count_[slot];
+    if (confirm_s_ <= 0 && count >= cap_) continue;  // full, and nothing to confirm
+    Eigen::Vector3f* v = pool_.data() + slot * cap_;
+    float* first_seen = confirm_s_ > 0 ? first_seen_s_.data() + slot * cap_ : nullptr;
     bool near = false;
-    std::size_t stale = v.size();  // a point never found again within the span: transient
-    for (std::size_t i = 0; i < v.size(); ++i) {
+    std::size_t stale = count;  // a point never found again within the span: transient
+    for (std::size_t i = 0; i < count; ++i) {
       const float d2 = (v[i] - p).squaredNorm();
-      if (confirm_s_ > 0) {
-        float& first = voxel.first_seen_s[i];
+      if (first_seen != nullptr) {
+        float& first = first_seen[i];
         if (first >= 0 && d2 < confirm_d2 && now_s - first >= confirm_s_) {
           first = kConfirmed;  // the same surface, a span later: the world
-        } else if (first >= 0 && now_s - first >= 2 * confirm_s_ && stale == v.size()) {
+        } else if (first >= 0 && now_s - first >= 2 * confirm_s_ && stale == count) {
           stale = i;
         }
       }
       if (d2 < min_d2) {
         near = true;
-        if (confirm_s_ <= 0) break;
+        if (first_seen == nullptr) break;
       }
     }
     if (near) continue;
-    if (v.size() >= cap) {
-      if (stale == v.size()) continue;
+    if (count >= cap_) {
+      if (stale == count) continue;
       // A full voxel makes room by forgetting what something passing through left.
       v[stale] = p;
-      voxel.first_seen_s[stale] = now_s;
+      first_seen[stale] = now_s;
       continue;
     }
-    v.push_back(p);
-    if (confirm_s_ > 0) voxel.first_seen_s.push_back(now_s);
+    v[count] = p;
+    if (first_seen != nullptr) first_seen[count] = now_s;
+    ++count;
     ++points_;
   }
 }
@@ -140,14 +145,17 @@ int VoxelMap::nearest(const Eigen::Vector3f& query, int k, float max_distance_m,
   for (const Offset& o : kByDistance) {
     const float box_d2 = face_d2[0][o.d[0] + 1] + face_d2[1][o.d[1] + 1] + face_d2[2][o.d[2] + 1];
     if (box_d2 > max_d2 || (found == kk && box_d2 >= best_d2[kk - 1])) continue;
-    const auto it = index_.find(key_of(centre + Eigen::Vector3i(o.d[0], o.d[1], o.d[2])));
-    if (it == index_.end()) continue;
-    const Voxel& cell = voxels_[it->second];
-    for (std::size_t i = 0; i < cell.points.size(); ++i) {
-      const Eigen::Vector3f& p = cell.points[i];
+    const std::uint32_t slot =
+        index_.find(key_of(centre + Eigen::Vector3i(o.d[0], o.d[1], o.d[2])));
+    if (slot == VoxelIndex::kNoSlot) continue;
+    const Eigen::Vector3f* points = pool_.data() + slot * cap_;
+    const float* first_seen = all ? nullptr : first_seen_s_.data() + slot * cap_;
+    const std::uint32_t count = slot_count_[slot];
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const Eigen::Vector3f& p = points[i];
       const float d2 = (p - query).squaredNorm();
       if (d2 > max_d2 || (found == kk && d2 >= best_d2[kk - 1])) continue;
-      if (!all && cell.first_seen_s[i] != kConfirmed) continue;
+      if (first_seen != nullptr && first_seen[i] != kConfirmed) continue;
       int pos = found < kk ? found++ : kk - 1;
       while (pos > 0 && best_d2[pos - 1] > d2) {
         best_d2[pos] = best_d2[pos - 1];
@@ -164,18 +172,15 @@ int VoxelMap::nearest(const Eigen::Vector3f& query, int k, float max_distance_m,
 std::size_t VoxelMap::remove_far_from(const Eigen::Vector3f& centre, double radius_m) {
   const float r2 = static_cast<float>(radius_m * radius_m);
   std::size_t removed = 0;
-  for (auto it = index_.begin(); it != index_.end();) {
-    Voxel& v = voxels_[it->second];
-    if (!v.points.empty() && (v.points.front() - centre).squaredNorm() > r2) {
-      points_ -= v.points.size();
-      v.points.clear();
-      v.first_seen_s.clear();
-      free_.push_back(it->second);
-      it = index_.erase(it);
-      ++removed;
-    } else {
-      ++it;
-    }
+  for (std::uint32_t slot = 0; slot < slot_key_.size(); ++slot) {
+    if (slot_key_[slot] == VoxelIndex::kEmptyKey || slot_count_[slot] == 0) continue;
+    if ((pool_[slot * cap_] - centre).squaredNorm() <= r2) continue;
+    points_ -= slot_count_[slot];
+    slot_count_[slot] = 0;
+    index_.erase(slot_key_[slot]);
+    slot_key_[slot] = VoxelIndex::kEmptyKey;
+    free_.push_back(slot);
+    ++removed;
   }
   return removed;
 }
@@ -183,24 +188,28 @@ std::size_t VoxelMap::remove_far_from(const Eigen::Vector3f& centre, double radi
 std::size_t VoxelMap::confirmed_points() const {
   if (confirm_s_ <= 0) return points_;
   std::size_t n = 0;
-  for (const auto& [key, slot] : index_) {
-    for (const float first : voxels_[slot].first_seen_s) n += first == kConfirmed;
+  for (std::size_t slot = 0; slot < slot_count_.size(); ++slot) {
+    const float* first_seen = first_seen_s_.data() + slot * cap_;
+    for (std::uint32_t i = 0; i < slot_count_[slot]; ++i) n += first_seen[i] == kConfirmed;
   }
   return n;
 }
 
 void VoxelMap::collect(std::vector<Eigen::Vector3f>& out) const {
-  for (const auto& [key, slot] : index_) {
-    const Voxel& voxel = voxels_[slot];
-    for (std::size_t i = 0; i < voxel.points.size(); ++i) {
-      if (confirm_s_ <= 0 || voxel.first_seen_s[i] == kConfirmed) out.push_back(voxel.points[i]);
+  for (std::size_t slot = 0; slot < slot_count_.size(); ++slot) {
+    for (std::uint32_t i = 0; i < slot_count_[slot]; ++i) {
+      const std::size_t at = slot * cap_ + i;
+      if (confirm_s_ <= 0 || first_seen_s_[at] == kConfirmed) out.push_back(pool_[at]);
     }
   }
 }
 
 void VoxelMap::clear() {
   index_.clear();
-  voxels_.clear();
+  slot_key_.clear();
+  slot_count_.clear();
+  pool_.clear();
+  first_seen_s_.clear();
   free_.clear();
   points_ = 0;
   started_ = false;

@@ -16,8 +16,9 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
+
+#include "core/lidar/voxel_index.hpp"
 
 namespace posed::lidar {
 
@@ -51,19 +52,24 @@ class VoxelMap {
   void clear();
 
  private:
-  struct Voxel {
-    std::vector<Eigen::Vector3f> points;  // reserved to max_points_per_voxel on creation
-    /// per point, with confirm_after_s: when it was first seen (map time) or kConfirmed [s]
-    std::vector<float> first_seen_s;
-  };
+  // Storage is flat, a slot per voxel: its points at [slot * cap, slot * cap + count) of one
+  // pool, so a lookup costs the index probe and the points, not a vector header between them.
+  /// The slot of the voxel `key`, made empty if the map had none.
+  std::uint32_t slot_for(std::uint64_t key);
+
   static constexpr float kConfirmed = -1.f;
   std::uint64_t key_of(const Eigen::Vector3i& v) const;
   Eigen::Vector3i voxel_of(const Eigen::Vector3f& p) const;
 
   VoxelMapConfig config_;
   float inv_voxel_;
-  std::unordered_map<std::uint64_t, std::uint32_t> index_;  // key -> slot in voxels_
-  std::vector<Voxel> voxels_;
+  std::size_t cap_;                        // max_points_per_voxel
+  VoxelIndex index_;                       // key -> slot
+  std::vector<std::uint64_t> slot_key_;    // per slot; VoxelIndex::kEmptyKey: free
+  std::vector<std::uint32_t> slot_count_;  // points held per slot
+  std::vector<Eigen::Vector3f> pool_;      // slot * cap_ + i
+  /// with confirm_after_s, per point of pool_: when it was first seen (map time) or kConfirmed [s]
+  std::vector<float> first_seen_s_;
   std::vector<std::uint32_t> free_;  // recycled slots
   std::size_t points_ = 0;
   float confirm_s_ = 0;

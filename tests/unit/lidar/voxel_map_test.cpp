@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -79,6 +80,38 @@ TEST(VoxelMapConfirmation, WhatPassedThroughAFullVoxelGivesItsPlaceToWhatCameAft
   ASSERT_EQ(kept.size(), 4u) << "the wall's points, confirmed";
   for (const Eigen::Vector3f& p : kept) EXPECT_NEAR(p.x(), 0.9f, 1e-4f);
   EXPECT_EQ(map.points(), 4u);
+}
+
+TEST(VoxelMap, ForgetsWhatIsOutOfReachAndReusesItsPlaces) {
+  // A drive along x: a 2 m x 2 m patch of points every metre; behind the robot the map is cut
+  // at 10 m, as LidarOdometry does. What stays must be found as before, what went must not be.
+  VoxelMap map({1.0, 20, 0.05, 0.0});
+  const auto patch = [](float x0) {
+    std::vector<Eigen::Vector3f> out;
+    for (int i = 0; i < 10; ++i) {
+      for (int j = 0; j < 10; ++j) {
+        out.emplace_back(x0 + 0.1f * static_cast<float>(i), 0.2f * static_cast<float>(j), 0.5f);
+      }
+    }
+    return out;
+  };
+  std::size_t most_voxels = 0;
+  for (int x = 0; x < 200; ++x) {
+    map.insert(patch(static_cast<float>(x)), x * kScanNs);
+    map.remove_far_from({static_cast<float>(x), 1.f, 0.5f}, 10.0);
+    most_voxels = std::max(most_voxels, map.voxels());
+    Eigen::Vector3f out[5];
+    ASSERT_EQ(map.nearest({static_cast<float>(x) + 0.45f, 1.f, 0.5f}, 5, 0.5f, out), 5) << x;
+    if (x >= 20) {
+      EXPECT_EQ(map.nearest({static_cast<float>(x - 15) + 0.45f, 1.f, 0.5f}, 5, 0.5f, out), 0)
+          << "forgotten at " << x;
+    }
+  }
+  EXPECT_LE(most_voxels, 24u) << "the map follows the robot";
+  std::vector<Eigen::Vector3f> kept;
+  map.collect(kept);
+  EXPECT_EQ(kept.size(), map.points());
+  for (const Eigen::Vector3f& p : kept) EXPECT_GT(p.x(), 199.f - 11.f);
 }
 
 }  // namespace
