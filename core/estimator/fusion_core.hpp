@@ -172,6 +172,9 @@ class FusionCore {
   /// one line for the summary and logs, e.g. "strapdown (IMU-only dead reckoning ...)"
   virtual std::string_view description() const = 0;
   virtual FusionFigures figures() const = 0;
+  /// Completes what the core hands to a lane of its own (the camera front end's): call once the
+  /// measurements have ended, before reading the final figures.
+  virtual void flush() {}
   /// Appends the map and keyframe poses built so far; cores without a map (IMU-only) add
   /// nothing, and so does a core not asked to keep one (LioConfig::keep_map).
   virtual void export_map(MapExport& out) const { (void)out; }

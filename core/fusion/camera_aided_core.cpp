@@ -1,21 +1,26 @@
 #include "core/fusion/camera_aided_core.hpp"
 
 #include <algorithm>
+#include <memory>
+#include <utility>
 
 namespace posed::fusion {
 
 CameraAidedCore::CameraAidedCore(std::unique_ptr<FusionCore> inner,
                                  const CameraFrontEndConfig& cameras,
                                  const CameraFactorsConfig& factors,
-                                 estimator::LioEstimator* window_owner)
+                                 estimator::LioEstimator* window_owner, TaskLane* lane)
     : inner_(std::move(inner)), cameras_(cameras) {
   const bool any_stream =
       std::any_of(factors.streams.begin(), factors.streams.end(), [](bool on) { return on; });
   std::string streams;
   if (window_owner != nullptr && any_stream) {
     factors_ = std::make_unique<CameraFactors>(factors);
-    window_owner->set_aiding(factors_.get());
+    window_owner->set_aiding(this);
     cameras_.set_back_end(this);
+    active_ = factors_->active();
+    // Only the window step joins the lane: without camera factors nothing would wait for it.
+    lane_ = lane;
     for (std::size_t i = 0; i < 3; ++i) {
       if (!factors.streams[i]) continue;
       if (!streams.empty()) streams += " and ";
@@ -24,8 +29,49 @@ CameraAidedCore::CameraAidedCore(std::unique_ptr<FusionCore> inner,
   }
   description_ = std::string(inner_->description()) + " with the " +
                  std::string(vision::to_string(cameras.frontend.mode)) + " camera front end";
+  if (lane_ != nullptr) description_ += " on a thread of its own";
   description_ += factors_ ? " (" + streams + " motion in the window, weighed by image quality)"
                            : " (features, quality and lidar depth; not in the estimate)";
+}
+
+CameraAidedCore::~CameraAidedCore() {
+  if (lane_ != nullptr) lane_->drain();  // its tasks point into this core
+}
+
+template <class Task>
+void CameraAidedCore::run(Task&& task) {
+  if (lane_ == nullptr) {
+    task();
+  } else {
+    lane_->post(std::forward<Task>(task));
+  }
+}
+
+void CameraAidedCore::sync() {
+  if (lane_ != nullptr) {
+    lane_->drain();
+    camera_figures_ = cameras_.figures();
+    if (factors_) visual_figures_ = factors_->figures();
+  }
+  if (factors_) active_ = factors_->active();
+}
+
+void CameraAidedCore::set_lidar_weak(bool weak) {
+  sync();
+  factors_->set_lidar_weak(weak);
+}
+
+void CameraAidedCore::relative_motions(const estimator::SlidingWindow& window,
+                                       const imu::ImuState& next,
+                                       std::vector<estimator::RelativeMotion>& out) {
+  sync();
+  factors_->relative_motions(window, next, out);
+}
+
+void CameraAidedCore::after_solve(const estimator::SlidingWindow& window) {
+  // The lane is idle: nothing was posted since the join in relative_motions.
+  factors_->after_solve(window);
+  active_ = factors_->active();
 }
 
 void CameraAidedCore::on_frame(const vision::FrontendFrame& frame,
@@ -35,14 +81,18 @@ void CameraAidedCore::on_frame(const vision::FrontendFrame& frame,
 }
 
 void CameraAidedCore::feed_states(const std::vector<NavState>& states, std::size_t first) {
-  for (std::size_t i = first; i < states.size(); ++i) cameras_.add_state(states[i]);
+  for (std::size_t i = first; i < states.size(); ++i) {
+    run([this, state = states[i]] { cameras_.add_state(state); });
+  }
 }
 
 void CameraAidedCore::add_imu(const ImuSample& sample, std::vector<NavState>& states) {
   // The cameras first: the frames this sample covers reach the back end before a scan it
   // releases, so the new state finds the last frame at or before its stamp.
-  cameras_.add_imu(sample);
-  cameras_.process(inner_->figures().gyro_bias_radps);
+  run([this, sample, bias = inner_->figures().gyro_bias_radps] {
+    cameras_.add_imu(sample);
+    cameras_.process(bias);
+  });
   const std::size_t first = states.size();
   inner_->add_imu(sample, states);
   feed_states(states, first);
@@ -52,20 +102,49 @@ void CameraAidedCore::add_scan(LidarScan scan, std::vector<NavState>& states) {
   const std::size_t first = states.size();
   inner_->add_scan(std::move(scan), states);
   MatchedScan matched;
-  if (inner_->latest_matched_scan(matched)) cameras_.add_scan(matched);
+  if (inner_->latest_matched_scan(matched)) {
+    if (lane_ == nullptr) {
+      cameras_.add_scan(matched);
+    } else {
+      // The points are a view into the core's last scan, which the next scan overwrites: the
+      // lane gets a copy.
+      auto copy = std::make_shared<std::vector<lidar::ScanPoint>>(matched.points_lidar.begin(),
+                                                                  matched.points_lidar.end());
+      lane_->post([this, matched, copy] {
+        MatchedScan own = matched;
+        own.points_lidar = *copy;
+        cameras_.add_scan(own);
+      });
+    }
+  }
   feed_states(states, first);
 }
 
 void CameraAidedCore::add_image(CameraStream stream, Image image, std::vector<NavState>& states) {
   (void)states;
-  cameras_.add_image(stream, std::move(image));
-  cameras_.process(inner_->figures().gyro_bias_radps);
+  const Eigen::Vector3d bias = inner_->figures().gyro_bias_radps;
+  if (lane_ == nullptr) {
+    cameras_.add_image(stream, std::move(image));
+    cameras_.process(bias);
+    return;
+  }
+  // A task must be copyable: the image (its pool buffer) travels in a shared holder.
+  auto held = std::make_shared<Image>(std::move(image));
+  lane_->post([this, stream, held, bias] {
+    cameras_.add_image(stream, std::move(*held));
+    cameras_.process(bias);
+  });
 }
 
 FusionFigures CameraAidedCore::figures() const {
   FusionFigures f = inner_->figures();
-  f.camera = cameras_.figures();
-  if (factors_) f.visual = factors_->figures();
+  if (lane_ == nullptr) {
+    f.camera = cameras_.figures();
+    if (factors_) f.visual = factors_->figures();
+  } else {
+    f.camera = camera_figures_;
+    f.visual = visual_figures_;
+  }
   return f;
 }
 

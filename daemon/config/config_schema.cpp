@@ -450,6 +450,10 @@ const Field kSchema[] = {
     F("frontend.thermal_nuc_frames", frontend.thermal_nuc_frames, "100", "frames", 1, 10000, "",
       "moving frames each pixel's learnt offset averages over (the pattern grows between the "
       "camera's flat-field corrections, which start the learning afresh)"),
+    F("frontend.own_thread", frontend.own_thread, "true", "", 0, 0, "",
+      "run the camera front end on a thread of its own (posed-camera), beside the lidar front "
+      "end, joined at each window step, when the cameras are in the estimate; false: on the "
+      "fusion thread. The estimate is the same either way"),
     F("frontend.wavelet", frontend.wavelet, "haar", "", 0, 0, "haar|legall53|cdf97",
       "wavelet of the 2-level DWT fusion"),
     F("frontend.fusion_noise_weighted", frontend.fusion_noise_weighted, "true", "", 0, 0, "",

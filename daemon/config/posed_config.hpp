@@ -188,11 +188,14 @@ struct FrontendSection {
   int thermal_depth_grid_cols = 40;               ///< lidar_depth registration grid [cells]
   int thermal_depth_grid_rows = 30;               ///< [cells]
   bool rotation_compensation = true;
-  bool thermal_nuc = false;           ///< scene-based non-uniformity correction of the thermal
-  double thermal_nuc_frames = 100;    ///< [frames] the NUC's offsets average over
-  std::string wavelet = "haar";       ///< haar | legall53 | cdf97
-  bool fusion_noise_weighted = true;  ///< false: seed 000's eq. (8) as published
-  bool fusion_denoise = true;         ///< noise-adaptive pre-smoothing of the fusion inputs
+  bool thermal_nuc = false;         ///< scene-based non-uniformity correction of the thermal
+  double thermal_nuc_frames = 100;  ///< [frames] the NUC's offsets average over
+  /// the front end on a thread of its own beside the lidar front end (with the cameras in the
+  /// window); false: on the fusion thread. The estimate is the same either way.
+  bool own_thread = true;
+  std::string wavelet = "haar";              ///< haar | legall53 | cdf97
+  bool fusion_noise_weighted = true;         ///< false: seed 000's eq. (8) as published
+  bool fusion_denoise = true;                ///< noise-adaptive pre-smoothing of the fusion inputs
   double fusion_denoise_target_sigma = 2.0;  ///< [grey]
   int max_features = 300;
   double min_feature_distance_px = 20;  ///< [px]

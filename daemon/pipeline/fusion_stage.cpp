@@ -291,6 +291,7 @@ void FusionStage::run() {
     }
     if (!handed) inputs_ready_.wait_for(kStageWaitTimeout);
   }
+  core_->flush();
   counters_.publish_figures(core_->figures());
   for (ScanObserver* observer : scan_observers_) observer->after_last_scan();
   states_.push(StateItem{{}, true});

@@ -7,6 +7,7 @@
 #include "core/estimator/fusion_core.hpp"
 #include "core/estimator/lio_estimator.hpp"
 #include "core/fusion/camera_aided_core.hpp"
+#include "daemon/pipeline/camera_lane.hpp"
 #include "daemon/pipeline/camera_stage.hpp"
 #include "daemon/pipeline/estimator_config.hpp"
 #include "daemon/pipeline/frontend_config.hpp"
@@ -53,6 +54,7 @@ std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
                                          estimator::LioEstimator* lio, const config::PosedConfig& c,
                                          bool has_visible, bool has_thermal, bool in_stamp_order,
                                          const PipelineOutputs& outputs,
+                                         std::unique_ptr<CameraLane>& lane,
                                          const fusion::CameraAidedCore*& camera_core) {
   camera_core = nullptr;
   if ((!has_visible && !has_thermal) || c.frontend.mode == "off") return inner;
@@ -68,7 +70,12 @@ std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
       cameras.compare_modes.push_back(m);
     }
   }
-  auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras, factors, lio);
+  if (c.frontend.own_thread && lio != nullptr) {
+    lane = std::make_unique<CameraLane>(c.threads.fusion);
+  }
+  auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras, factors, lio,
+                                                        lane.get());
+  if (lane && !core->threaded()) lane.reset();  // the cameras are not in the window: no join
   core->cameras().set_observer(outputs.frontend_observer);
   camera_core = core.get();
   return core;
@@ -200,7 +207,8 @@ bool Pipeline::start(std::string& error) {
   std::unique_ptr<FusionCore> core =
       make_core(config_, sources_.lidar != nullptr, outputs_.keep_map, lio);
   core = with_cameras(std::move(core), lio, config_, sources_.visible != nullptr,
-                      sources_.thermal != nullptr, in_stamp_order, outputs_, camera_core_);
+                      sources_.thermal != nullptr, in_stamp_order, outputs_, camera_lane_,
+                      camera_core_);
   // Odometry apart from the back end needs a back end with optimised states to anchor on (the
   // lidar-inertial one); IMU-only dead reckoning is itself the cheap propagation.
   OdometryHandover handover;

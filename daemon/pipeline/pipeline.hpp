@@ -45,6 +45,7 @@ class ImuStage;
 class RealsenseImuStage;
 class LidarStage;
 class CameraStage;
+class CameraLane;
 class FusionStage;
 class PublisherStage;
 struct LidarScanCounters;
@@ -213,6 +214,9 @@ class Pipeline {
   std::unique_ptr<RealsenseImuStage> realsense_imu_stage_;
   std::unique_ptr<LidarStage> lidar_stage_;
   std::unique_ptr<CameraStage> camera_stages_[2];
+  /// the camera front end's thread (frontend.own_thread); declared before the fusion stage,
+  /// whose core posts to it, so it outlives that core
+  std::unique_ptr<CameraLane> camera_lane_;
   std::unique_ptr<FusionStage> fusion_stage_;
   /// the fusion core when it has cameras (owned by fusion_stage_)
   const fusion::CameraAidedCore* camera_core_ = nullptr;

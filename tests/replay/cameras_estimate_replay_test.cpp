@@ -2,8 +2,10 @@
 // down the simulated coal-mine roadway (`tunnel`: its lidar geometry is the same along its axis,
 // its shotcrete walls are textured for the colour camera), `posed --replay --max-speed --record`
 // runs it with the visible camera's motion in the window, twice, and once with the cameras off.
-// The lidar alone loses the axis; with the camera the poses follow the ground truth, and the two
-// camera replays are bit-identical.
+// The lidar alone loses the axis; with the camera the poses follow the ground truth. The two
+// camera replays run the camera front end on a thread of its own (the default) and on the fusion
+// thread (frontend.own_thread: false), and are bit-identical: the thread changes the speed, not
+// the estimate.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -53,11 +55,12 @@ struct Replay {
 };
 
 Replay replay(TempDir& dir, const std::string& recording, const std::string& mode,
-              const std::string& name) {
-  const std::string config = dir.write(
-      name + ".yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                          "\n  cyclonedds_config: " + source_dir() +
-                          "/config/cyclonedds-loopback.xml\nfrontend:\n  mode: " + mode + "\n");
+              const std::string& name, bool own_thread = true) {
+  const std::string config =
+      dir.write(name + ".yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
+                                    "\n  cyclonedds_config: " + source_dir() +
+                                    "/config/cyclonedds-loopback.xml\nfrontend:\n  mode: " + mode +
+                                    "\n  own_thread: " + (own_thread ? "true" : "false") + "\n");
   PosedProcess posed(
       {build_dir() + "/daemon/posed", "--config", config, "--replay", recording, "--max-speed",
        "--wait-subscribers", "0", "--record", dir.file(name + ".mcap")},
@@ -77,7 +80,7 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
   }
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   const Replay a = replay(dir, recording, "visible", "a");
-  const Replay b = replay(dir, recording, "visible", "b");
+  const Replay b = replay(dir, recording, "visible", "b", false);
   const Replay lio = replay(dir, recording, "off", "lio");
   ASSERT_GT(a.poses.size(), 250u);  // 10 Hz after the 2 s standing start
 
@@ -88,8 +91,11 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
       << a.summary;
   EXPECT_GT(std::stoi(m[1]), 200);
   EXPECT_NE(a.summary.find("imu+lidar+visible"), std::string::npos) << a.summary;
+  EXPECT_NE(a.summary.find("camera front end on a thread of its own"), std::string::npos)
+      << a.summary;
+  EXPECT_EQ(b.summary.find("on a thread of its own"), std::string::npos) << b.summary;
 
-  // Bit-identical replays with the camera in the estimate.
+  // Bit-identical replays with the camera in the estimate, its front end threaded or not.
   ASSERT_EQ(a.poses.size(), b.poses.size());
   for (auto ia = a.poses.begin(), ib = b.poses.begin(); ia != a.poses.end(); ++ia, ++ib) {
     ASSERT_EQ(ia->first, ib->first);

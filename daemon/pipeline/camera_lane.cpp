@@ -1,0 +1,64 @@
+#include "daemon/pipeline/camera_lane.hpp"
+
+#include <utility>
+
+#include "daemon/pipeline/thread_policy.hpp"
+
+namespace posed::pipeline {
+
+CameraLane::CameraLane(const config::ThreadSection& policy, std::size_t capacity)
+    : capacity_(capacity > 0 ? capacity : 1), thread_([this, policy] { run(policy); }) {}
+
+CameraLane::~CameraLane() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  work_.notify_all();
+  thread_.join();
+}
+
+void CameraLane::post(Task task) {
+  std::unique_lock lock(mutex_);
+  if (tasks_.size() >= capacity_) {
+    ++counters_.full_waits;
+    room_.wait(lock, [&] { return tasks_.size() < capacity_; });
+  }
+  tasks_.push_back(std::move(task));
+  lock.unlock();
+  work_.notify_one();
+}
+
+void CameraLane::drain() {
+  std::unique_lock lock(mutex_);
+  if (tasks_.empty() && !running_task_) return;
+  ++counters_.drain_waits;
+  idle_.wait(lock, [&] { return tasks_.empty() && !running_task_; });
+}
+
+CameraLaneCounters CameraLane::counters() const {
+  std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+void CameraLane::run(config::ThreadSection policy) {
+  apply_thread_policy("posed-camera", policy);
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    work_.wait(lock, [&] { return !tasks_.empty() || stopping_; });
+    if (tasks_.empty()) break;  // stopping, and everything posted has run
+    Task task = std::move(tasks_.front());
+    tasks_.pop_front();
+    running_task_ = true;
+    lock.unlock();
+    room_.notify_one();
+    task();
+    task = nullptr;  // what it held (an image's pool buffer) goes back now, not at the next task
+    lock.lock();
+    running_task_ = false;
+    ++counters_.tasks;
+    if (tasks_.empty()) idle_.notify_all();
+  }
+}
+
+}  // namespace posed::pipeline
