@@ -61,7 +61,7 @@ void ImageOutput::run() {
     std::swap(frame, pending_frame_);
     full_ = false;
     lock.unlock();
-    // Outside the lock: the fusion thread copies the next frame while this one is encoded.
+    // Outside the lock: the front end's thread copies the next frame while this one is encoded.
     const auto began = std::chrono::steady_clock::now();
     // libturbojpeg (as the MJPEG decoder), not OpenCV's imgcodecs: linking that into posed
     // brings codec libraries whose start-up calls fall outside the unit's system-call filter.

@@ -1,10 +1,10 @@
 #pragma once
-// rt/posed/image/compressed off the fusion thread: the camera front end's tracked image with its
-// features drawn on it (vision::feature_overlay), JPEG, at most publish.image_rate_hz and only
-// while someone reads it (a DDS reader, Foxglove, a recording). The fusion thread copies the
-// image and the frame's features into a one-slot mailbox; this object's thread draws, encodes and
-// writes, so a slow reader or the encoder never delays the estimate. A frame not yet written when
-// a newer one comes is replaced (counted).
+// rt/posed/image/compressed off the estimate's threads: the camera front end's tracked image with
+// its features drawn on it (vision::feature_overlay), JPEG, at most publish.image_rate_hz and only
+// while someone reads it (a DDS reader, Foxglove, a recording). The front end's thread (its own,
+// or the fusion thread) copies the image and the frame's features into a one-slot mailbox; this
+// object's thread draws, encodes and writes, so a slow reader or the encoder never delays the
+// estimate. A frame not yet written when a newer one comes is replaced (counted).
 
 #include <condition_variable>
 #include <cstdint>
@@ -38,7 +38,7 @@ class ImageOutput final : public fusion::FrontendObserver {
   ImageOutput(const ImageOutput&) = delete;
   ImageOutput& operator=(const ImageOutput&) = delete;
 
-  /// On the fusion thread, for every frame the configured front end processed.
+  /// On the front end's thread, for every frame the configured front end processed.
   void on_frame(const vision::FrontendFrame& frame,
                 const vision::VisualFrontend& frontend) override;
   /// Writes what is still waiting and ends the thread. Idempotent.
