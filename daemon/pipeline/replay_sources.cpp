@@ -84,6 +84,8 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
 
   const auto timeline =
       options.live_stamps ? std::make_shared<recording::ReplayTimeline>() : nullptr;
+  // The streams read the file side by side; each chunk is decompressed once for all of them.
+  const auto chunks = std::make_shared<recording::McapChunkCache>();
   const auto make = [&](const std::string& stream) {
     recording::McapReplayConfig c;
     c.path = options.path;
@@ -96,6 +98,7 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     c.loop = false;
     c.time_shift = options.time_shift;
     c.live_timeline = timeline;
+    c.chunk_cache = chunks;
     auto source = std::make_unique<recording::McapReplaySource>(std::move(c));
     out.replayers.push_back(source.get());
     return source;

@@ -320,6 +320,7 @@ void McapReader::rewind() {
   crc_pos_ = 0;
   chunk_records_ = {};
   chunk_pos_ = 0;
+  shared_chunk_.reset();
   seen_channels_.reset();
 }
 
@@ -412,6 +413,27 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
     return false;
   }
   std::span<const std::byte> plain;
+  shared_chunk_.reset();
+  McapChunkCache* const cache = compression.empty() ? nullptr : options_.chunk_cache.get();
+  if (cache != nullptr) {
+    if (McapChunkCache::Chunk hit = cache->find(offset)) {
+      // Decompressed and CRC-checked by the reader that added it.
+      shared_chunk_ = std::move(hit);
+      ++counters_.chunks;
+      chunk_records_ = *shared_chunk_;
+      chunk_pos_ = 0;
+      chunk_offset_ = offset;
+      return true;
+    }
+  }
+  // A chunk for the cache gets a buffer of its own: the other readers may still walk it after
+  // this reader has moved on.
+  // Only what this reader checked is shared.
+  std::shared_ptr<std::vector<std::byte>> own =
+      cache != nullptr && (options_.verify_crcs || crc == 0)
+          ? std::make_shared<std::vector<std::byte>>()
+          : nullptr;
+  std::vector<std::byte>& buf = own ? *own : chunk_buf_;
   if (compression.empty()) {
     if (records.size() != uncompressed_size) {
       ++counters_.chunks_bad;
@@ -427,11 +449,11 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
     }
     auto* ctx = static_cast<LZ4F_dctx*>(lz4_ctx_);
     LZ4F_resetDecompressionContext(ctx);
-    chunk_buf_.resize(static_cast<std::size_t>(uncompressed_size));
-    std::size_t dst_size = chunk_buf_.size();
+    buf.resize(static_cast<std::size_t>(uncompressed_size));
+    std::size_t dst_size = buf.size();
     std::size_t src_size = records.size();
     const std::size_t r =
-        LZ4F_decompress(ctx, chunk_buf_.data(), &dst_size, records.data(), &src_size, nullptr);
+        LZ4F_decompress(ctx, buf.data(), &dst_size, records.data(), &src_size, nullptr);
     if (LZ4F_isError(r) != 0u || r != 0 || dst_size != uncompressed_size) {
       ++counters_.chunks_bad;
       issue(offset,
@@ -439,12 +461,12 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
                 LZ4F_isError(r) != 0u ? LZ4F_getErrorName(r) : "size mismatch"));
       return false;
     }
-    plain = chunk_buf_;
+    plain = buf;
   } else if (compression == "zstd") {
     if (zstd_ctx_ == nullptr) zstd_ctx_ = ZSTD_createDCtx();
-    chunk_buf_.resize(static_cast<std::size_t>(uncompressed_size));
-    const std::size_t r = ZSTD_decompressDCtx(static_cast<ZSTD_DCtx*>(zstd_ctx_), chunk_buf_.data(),
-                                              chunk_buf_.size(), records.data(), records.size());
+    buf.resize(static_cast<std::size_t>(uncompressed_size));
+    const std::size_t r = ZSTD_decompressDCtx(static_cast<ZSTD_DCtx*>(zstd_ctx_), buf.data(),
+                                              buf.size(), records.data(), records.size());
     if (ZSTD_isError(r) != 0u || r != uncompressed_size) {
       ++counters_.chunks_bad;
       issue(offset,
@@ -452,7 +474,7 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
                 ZSTD_isError(r) != 0u ? ZSTD_getErrorName(r) : "size mismatch"));
       return false;
     }
-    plain = chunk_buf_;
+    plain = buf;
   } else {
     ++counters_.chunks_bad;
     issue(offset, "Chunk with unknown compression '" + compression.substr(0, 32) + "': skipped");
@@ -465,6 +487,10 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
       issue(offset, fmt("Chunk CRC mismatch (stored 0x%08x, computed 0x%08x): skipped", crc, got));
       return false;
     }
+  }
+  if (own) {
+    shared_chunk_ = own;
+    cache->add(offset, std::move(own));
   }
   ++counters_.chunks;
   chunk_records_ = plain;

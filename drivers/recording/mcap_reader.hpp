@@ -21,6 +21,7 @@
 
 #include "drivers/recording/crc32.hpp"
 #include "drivers/recording/mapped_file.hpp"
+#include "drivers/recording/mcap_chunk_cache.hpp"
 
 namespace posed::drivers::recording {
 
@@ -108,6 +109,8 @@ struct McapReaderOptions {
   std::uint64_t min_log_time_ns = 0;
   /// refuse chunks that claim more than this when decompressed [B]
   std::uint64_t max_chunk_bytes = 512ull << 20;
+  /// compressed chunks decompressed by another reader of the same file (null: none shared)
+  std::shared_ptr<McapChunkCache> chunk_cache;
 };
 
 class McapReader {
@@ -183,6 +186,8 @@ class McapReader {
   std::size_t chunk_pos_ = 0;
   std::uint64_t chunk_offset_ = 0;
   std::vector<std::byte> chunk_buf_;
+  /// the chunk being walked when it came from (or went to) options_.chunk_cache
+  McapChunkCache::Chunk shared_chunk_;
   void* zstd_ctx_ = nullptr;
   void* lz4_ctx_ = nullptr;
 

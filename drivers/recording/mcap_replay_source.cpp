@@ -25,7 +25,9 @@ bool McapReplaySource::wanted(const McapChannelRecord& c) const {
 
 bool McapReplaySource::open(std::string& error) {
   if (opened_) return true;
-  if (!reader_.open(config_.path, error)) return false;
+  McapReaderOptions options;
+  options.chunk_cache = config_.chunk_cache;
+  if (!reader_.open(config_.path, error, options)) return false;
   if (reader_.summary().usable()) {
     std::set<std::string> streams;
     bool found = false;

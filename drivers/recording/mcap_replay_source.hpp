@@ -70,6 +70,8 @@ struct McapReplayConfig {
   /// shared by the replay's Sources: paced at recorded timing (rate is ignored) and re-stamped
   /// onto the host clock now; null: receive times are the recorded log times
   std::shared_ptr<ReplayTimeline> live_timeline;
+  /// shared by the replay's Sources: a chunk one stream decompressed, the others read from memory
+  std::shared_ptr<McapChunkCache> chunk_cache;
 };
 
 /// One raw channel of the stream, as recorded.

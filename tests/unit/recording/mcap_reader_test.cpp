@@ -205,6 +205,43 @@ TEST(BadInput, AChunkWithABadCrcIsSkippedAndTheRestIsRead) {
   EXPECT_TRUE(data_crc);
 }
 
+TEST(ChunkCache, ReadersOfOneFileShareDecompressedChunksAndNeverADamagedOne) {
+  test::TempDir dir("mcap_cache");
+  const auto w = write_file(dir.file("f.mcap"), McapCompression::kLz4, 400, 1024);
+  auto bytes = test::slurp(dir.file("f.mcap"));
+  ASSERT_GE(w.chunks.size(), 4u);
+  const auto& victim = w.chunks[2];
+  // A byte in the middle of its compressed records: it no longer decompresses, or fails its CRC.
+  bytes[static_cast<std::size_t>(victim.start_offset + victim.chunk_length / 2 + 20)] ^= std::byte{0x55};
+  McapReaderOptions options;
+  options.chunk_cache = std::make_shared<McapChunkCache>(4);
+  McapReader first, second;
+  std::string error;
+  ASSERT_TRUE(first.open_bytes(bytes, error, options)) << error;
+  ASSERT_TRUE(second.open_bytes(bytes, error, options)) << error;
+  // Side by side, as a replay's streams read: every message of both, from one decompression per
+  // good chunk; the damaged chunk is reported by each reader, not handed from one to the other.
+  std::vector<std::uint32_t> a, b;
+  McapMessage m;
+  for (bool more_a = true, more_b = true; more_a || more_b;) {
+    if (more_a && (more_a = first.next(m))) a.push_back(m.sequence);
+    if (more_b && (more_b = second.next(m))) {
+      b.push_back(m.sequence);
+      const auto want = payload_for(m.sequence);
+      ASSERT_TRUE(m.data.size() == want.size() &&
+                  std::memcmp(m.data.data(), want.data(), want.size()) == 0);
+    }
+  }
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a.size(), 400u - victim.message_count);
+  EXPECT_EQ(first.counters().chunks_bad, 1u);
+  EXPECT_EQ(second.counters().chunks_bad, 1u);
+  EXPECT_EQ(first.counters().chunks + second.counters().chunks, 2 * (w.chunks.size() - 1));
+  const McapChunkCacheCounters c = options.chunk_cache->counters();
+  EXPECT_EQ(c.hits, w.chunks.size() - 1) << "the second reader found every good chunk";
+  EXPECT_EQ(c.misses, w.chunks.size() + 1) << "the first reader's, and the damaged one twice";
+}
+
 TEST(BadInput, ASummaryWithABadCrcFallsBackToTheScan) {
   test::TempDir dir("mcap_sumcrc");
   write_file(dir.file("f.mcap"), McapCompression::kLz4, 50);

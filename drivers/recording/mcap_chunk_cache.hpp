@@ -1,0 +1,67 @@
+#pragma once
+// Decompressed chunks shared by several readers of one MCAP file. A replay reads the file once per
+// stream (each McapReplaySource has its own McapReader, so a stream never waits for another), and
+// each reader used to decompress and CRC every chunk: with four streams, LZ4 and the CRC were a
+// sixth of a four-sensor replay's CPU. The streams advance through the file roughly together, so
+// the first reader to reach a chunk decompresses and checks it and the others find it here. Only
+// chunks that decompressed to their size and passed their CRC are shared; a reader that misses
+// (evicted, or far ahead) decompresses on its own, so nothing depends on the cache but speed.
+// Thread-safe; a chunk handed out stays alive while a reader walks it, whatever is evicted.
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
+
+namespace posed::drivers::recording {
+
+struct McapChunkCacheCounters {
+  std::uint64_t hits = 0;    ///< chunks a reader found decompressed [1]
+  std::uint64_t misses = 0;  ///< chunks a reader decompressed itself [1]
+};
+
+class McapChunkCache {
+ public:
+  using Chunk = std::shared_ptr<const std::vector<std::byte>>;
+
+  /// Keeps the `capacity` chunks most recently added.
+  explicit McapChunkCache(std::size_t capacity = 32) : capacity_(capacity) {}
+
+  /// The chunk at file offset `offset`, decompressed and checked, or null.
+  Chunk find(std::uint64_t offset) {
+    std::lock_guard lock(mutex_);
+    for (const auto& [at, chunk] : chunks_) {
+      if (at == offset) {
+        ++counters_.hits;
+        return chunk;
+      }
+    }
+    ++counters_.misses;
+    return nullptr;
+  }
+
+  void add(std::uint64_t offset, Chunk chunk) {
+    std::lock_guard lock(mutex_);
+    for (const auto& entry : chunks_) {
+      if (entry.first == offset) return;  // another reader was quicker
+    }
+    chunks_.emplace_back(offset, std::move(chunk));
+    if (chunks_.size() > capacity_) chunks_.pop_front();
+  }
+
+  McapChunkCacheCounters counters() const {
+    std::lock_guard lock(mutex_);
+    return counters_;
+  }
+
+ private:
+  const std::size_t capacity_;
+  mutable std::mutex mutex_;
+  std::deque<std::pair<std::uint64_t, Chunk>> chunks_;  // oldest first
+  McapChunkCacheCounters counters_;
+};
+
+}  // namespace posed::drivers::recording
