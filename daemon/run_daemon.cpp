@@ -246,6 +246,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   pipeline::BuiltSources built;
   std::string replay_streams;
   std::vector<const drivers::recording::McapReplaySource*> replayers;
+  std::shared_ptr<drivers::recording::McapChunkCache> replay_chunks;
   if (replaying) {
     pipeline::ReplaySources replay = pipeline::make_replay_sources(options.replay, error);
     // Replayed stamps are the recording's host clock; its wall offset keeps the DDS stamps (and
@@ -255,6 +256,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     built = std::move(replay.built);
     replay_streams = replay.streams;
     replayers = std::move(replay.replayers);
+    replay_chunks = replay.chunks;
     if (options.replay.recorded_config) {
       POSED_LOG_INFO("configuration as recorded in %s%s%s", options.replay.path.c_str(),
                      built.sources.lidar_calibration_text.empty() ? "" : "; lidar calibration: ",
@@ -476,6 +478,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     ::malloc_trim(0);
     built = std::move(replay.built);
     replayers = std::move(replay.replayers);
+    replay_chunks = replay.chunks;
     if (recorder) pipeline::tap_sources(built.sources, *recorder, config);
     sinks.new_pass();
   }
@@ -503,10 +506,12 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     map_line += (map_line.empty() ? "" : "; ") + dir_line;
   }
 
-  const RunSummary summary{
-      config,         options,          *pipe,          sinks,    started,     pipeline_started,
-      replay_streams, built_has_lidar,  recorder.get(), map_line, synthetic,   publisher != nullptr,
-      extra.clouds(), extra.foxglove(), extra.images(), passes,   pass_started};
+  const RunSummary summary{config,         options,          *pipe,
+                           sinks,          started,          pipeline_started,
+                           replay_streams, built_has_lidar,  recorder.get(),
+                           map_line,       synthetic,        publisher != nullptr,
+                           extra.clouds(), extra.foxglove(), extra.images(),
+                           passes,         pass_started,     replay_chunks.get()};
   // A timed run that never aligned is not a failure of the run itself.
   if (!print_run_summary(summary) && options.duration_s > 0) exit_code = 0;
   return exit_code;

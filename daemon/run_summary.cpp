@@ -11,6 +11,7 @@
 #include "daemon/pipeline/pipeline.hpp"
 #include "daemon/resident_memory.hpp"
 #include "drivers/common/host_clock.hpp"
+#include "drivers/recording/mcap_chunk_cache.hpp"
 #include "drivers/recording/recorder.hpp"
 #include "drivers/synthetic/synthetic_imu_source.hpp"
 
@@ -148,6 +149,15 @@ bool print_run_summary(const RunSummary& r) {
   if (!r.options.replay.path.empty()) {
     std::printf("  replayed            %s (%s)\n", r.options.replay.path.c_str(),
                 r.replay_streams.c_str());
+    if (r.replay_chunks != nullptr) {
+      const drivers::recording::McapChunkCacheCounters c = r.replay_chunks->counters();
+      const std::uint64_t reads = c.hits + c.misses;
+      std::printf(
+          "  replay reading      %llu compressed chunks decompressed, %llu reads served from "
+          "another stream's (%.1f %%)\n",
+          static_cast<unsigned long long>(c.misses), static_cast<unsigned long long>(c.hits),
+          reads > 0 ? 100.0 * static_cast<double>(c.hits) / static_cast<double>(reads) : 0.0);
+    }
     if (r.options.replay.loop) {
       std::printf(
           "  passes              %llu, each from a fresh start (decoders, clock sync, "
@@ -275,7 +285,8 @@ bool print_run_summary(const RunSummary& r) {
                 static_cast<unsigned long long>(rc.dropped));
   }
   if (!r.map_line.empty()) std::printf("  map                 %s\n", r.map_line.c_str());
-  if (const auto mapping = r.pipe.mapping_figures()) print_mapping_summary(*mapping, r.sinks.to_wall());
+  if (const auto mapping = r.pipe.mapping_figures())
+    print_mapping_summary(*mapping, r.sinks.to_wall());
   if (tally.last) {
     const NavState& s = *tally.last;
     std::printf("  final pose          x %.3f m, y %.3f m, z %.3f m, yaw %.1f deg\n",

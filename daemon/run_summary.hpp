@@ -20,7 +20,8 @@ class SyntheticImuSource;
 }
 namespace drivers::recording {
 class Recorder;
-}
+class McapChunkCache;
+}  // namespace drivers::recording
 
 class CloudOutput;
 class ImageOutput;
@@ -46,6 +47,8 @@ struct RunSummary {
   const ImageOutput* images = nullptr;         ///< stopped; null: no image output
   std::uint64_t passes = 1;    ///< over the recording (--loop); the figures above are the last's
   HostTime last_pass_started;  ///< the last pass's start (its streams' mean rates)
+  /// the chunks the last pass's streams shared; null: not a replay
+  const drivers::recording::McapChunkCache* replay_chunks = nullptr;
 };
 
 /// Prints it to stdout; false when there was no pose at all (the estimator never aligned).

@@ -85,7 +85,8 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   const auto timeline =
       options.live_stamps ? std::make_shared<recording::ReplayTimeline>() : nullptr;
   // The streams read the file side by side; each chunk is decompressed once for all of them.
-  const auto chunks = std::make_shared<recording::McapChunkCache>();
+  out.chunks = std::make_shared<recording::McapChunkCache>();
+  const auto& chunks = out.chunks;
   const auto make = [&](const std::string& stream) {
     recording::McapReplayConfig c;
     c.path = options.path;

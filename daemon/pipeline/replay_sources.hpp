@@ -4,11 +4,13 @@
 // block instead of dropping and a replay at full speed is deterministic.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/time.hpp"
 #include "daemon/pipeline/source_factory.hpp"
+#include "drivers/recording/mcap_chunk_cache.hpp"
 
 namespace posed::drivers::recording {
 class McapReplaySource;
@@ -48,6 +50,9 @@ struct ReplaySources {
   std::string streams;
   /// the replay Sources in `built`, to ask what a pass delivered (valid while they live)
   std::vector<const drivers::recording::McapReplaySource*> replayers;
+  /// the chunks the streams share (its counters: how often one stream's decompression served
+  /// another)
+  std::shared_ptr<drivers::recording::McapChunkCache> chunks;
 };
 
 /// On failure the sources are empty and `error` names the file and the problem.
