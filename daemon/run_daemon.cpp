@@ -11,6 +11,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -186,21 +187,21 @@ void log_pass(std::uint64_t pass, const pipeline::Pipeline& pipe, const PoseSink
                  static_cast<unsigned long long>(f.reinitialisations), depth);
 }
 
-}  // namespace
+constexpr std::string_view kPcd = ".pcd";
 
-bool is_map_directory_path(const std::string& map_path) {
-  const std::string ext = ".pcd";
-  return !(map_path.size() > ext.size() &&
-           map_path.compare(map_path.size() - ext.size(), ext.size(), ext) == 0);
+/// "X.pcd" (a name before the suffix): the PCD + TUM map files, not a map directory.
+bool ends_with_pcd(const std::string& path) {
+  return path.size() > kPcd.size() && path.ends_with(kPcd);
 }
 
+}  // namespace
+
+bool is_map_directory_path(const std::string& map_path) { return !ends_with_pcd(map_path); }
+
 std::string keyframes_path_for(const std::string& map_path) {
-  const std::string ext = ".pcd";
-  if (map_path.size() > ext.size() &&
-      map_path.compare(map_path.size() - ext.size(), ext.size(), ext) == 0) {
-    return map_path.substr(0, map_path.size() - ext.size()) + ".keyframes.tum";
-  }
-  return map_path + ".keyframes.tum";
+  const std::string stem =
+      ends_with_pcd(map_path) ? map_path.substr(0, map_path.size() - kPcd.size()) : map_path;
+  return stem + ".keyframes.tum";
 }
 
 int run_daemon(const config::PosedConfig& configured, const RunOptions& options) {

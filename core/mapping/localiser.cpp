@@ -129,27 +129,30 @@ void Localiser::take(const Fix& fix, HostTime stamp, const Eigen::Isometry3d& T_
   selector_.take(T_odom_base);
 }
 
+std::vector<std::size_t> Localiser::nearest_keyframes(const Eigen::Vector3d& centre_map_m,
+                                                      std::size_t cap,
+                                                      std::optional<std::size_t> exclude) const {
+  std::vector<std::pair<double, std::size_t>> near;
+  for (std::size_t i = 0; i < map_.keyframes.size(); ++i) {
+    const double d = (map_.keyframes[i].T_map_base.translation() - centre_map_m).norm();
+    if (i != exclude && d <= config_.track_radius_m) near.emplace_back(d, i);
+  }
+  const std::size_t n = std::min(near.size(), cap);
+  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < n; ++k) out.push_back(near[k].second);
+  return out;
+}
+
 std::optional<Localiser::Fix> Localiser::fix_near(const DescribedScan& scan,
                                                   const Eigen::Isometry3d& T_odom_query,
                                                   const Eigen::Isometry3d& T_map_query_guess) {
-  std::vector<std::pair<double, std::size_t>> near;
-  for (std::size_t i = 0; i < map_.keyframes.size(); ++i) {
-    const double d =
-        (map_.keyframes[i].T_map_base.translation() - T_map_query_guess.translation()).norm();
-    if (d <= config_.track_radius_m) {
-      near.emplace_back(d, i);
-    }
-  }
-  if (near.empty()) {
+  const std::vector<std::size_t> keyframes =
+      nearest_keyframes(T_map_query_guess.translation(),
+                        static_cast<std::size_t>(std::max(0, config_.track_keyframes)));
+  if (keyframes.empty()) {
     ++figures_.off_map;
     return std::nullopt;
-  }
-  const auto n =
-      std::min<std::size_t>(near.size(), static_cast<std::size_t>(config_.track_keyframes));
-  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
-  std::vector<std::size_t> keyframes;
-  for (std::size_t k = 0; k < n; ++k) {
-    keyframes.push_back(near[k].second);
   }
   const Eigen::Isometry3d T_first_query_guess =
       map_.keyframes[keyframes.front()].T_map_base.inverse() * T_map_query_guess;
@@ -167,20 +170,11 @@ std::optional<Localiser::Fix> Localiser::fix_by_descriptor(const DescribedScan& 
     return std::nullopt;
   }
   // The matched keyframe first (the registration's frame), then its neighbours in the map.
-  const Eigen::Vector3d centre = map_.keyframes[match->index].T_map_base.translation();
-  std::vector<std::pair<double, std::size_t>> near;
-  for (std::size_t i = 0; i < map_.keyframes.size(); ++i) {
-    const double d = (map_.keyframes[i].T_map_base.translation() - centre).norm();
-    if (i != match->index && d <= config_.track_radius_m) {
-      near.emplace_back(d, i);
-    }
-  }
-  const auto n = std::min<std::size_t>(
-      near.size(), static_cast<std::size_t>(std::max(0, config_.track_keyframes - 1)));
-  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
   std::vector<std::size_t> keyframes{match->index};
-  for (std::size_t k = 0; k < n; ++k) {
-    keyframes.push_back(near[k].second);
+  for (const std::size_t i : nearest_keyframes(
+           map_.keyframes[match->index].T_map_base.translation(),
+           static_cast<std::size_t>(std::max(0, config_.track_keyframes - 1)), match->index)) {
+    keyframes.push_back(i);
   }
   return register_onto(scan, T_odom_query, keyframes, match->T_match_query_guess);
 }

@@ -245,6 +245,17 @@ bool parse_stamp(const std::string& text, std::int64_t& stamp_ns) {
   }
 }
 
+/// The pose of "tx ty tz qx qy qz qw" (as TUM writes it); false when it is not finite or its
+/// quaternion is not unit.
+bool pose_of(const double (&v)[7], Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  const Eigen::Vector3d t(v[0], v[1], v[2]);
+  if (!t.allFinite() || !std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) return false;
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = t;
+  return true;
+}
+
 bool read_keyframes(const std::string& path, mapping::KeyframeMap& map, std::string& error) {
   return for_each_line(path, error, [&](const std::string& line, std::size_t number) {
     std::istringstream fields(line);
@@ -259,14 +270,10 @@ bool read_keyframes(const std::string& path, mapping::KeyframeMap& map, std::str
       error = at(path, number, "stamp '" + stamp + "' is not SECONDS.NANOSECONDS");
       return false;
     }
-    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-    if (!Eigen::Vector3d(v[0], v[1], v[2]).allFinite() || !std::isfinite(q.norm()) ||
-        std::abs(q.norm() - 1.0) > 1e-3) {
+    if (!pose_of(v, kf.T_map_base)) {
       error = at(path, number, "pose is not finite or its quaternion not unit");
       return false;
     }
-    kf.T_map_base.linear() = q.normalized().toRotationMatrix();
-    kf.T_map_base.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
     map.keyframes.push_back(std::move(kf));
     return true;
   });
@@ -291,14 +298,11 @@ bool read_edges(const std::string& path, mapping::KeyframeMap& map, std::string&
       error = at(path, number, "joins a keyframe the map does not have");
       return false;
     }
-    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-    if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) {
-      error = at(path, number, "quaternion not unit");
+    if (!pose_of(v, e.T_from_to)) {
+      error = at(path, number, "pose is not finite or its quaternion not unit");
       return false;
     }
     e.loop = kind == "loop";
-    e.T_from_to.linear() = q.normalized().toRotationMatrix();
-    e.T_from_to.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
     map.edges.push_back(e);
     return true;
   });
