@@ -513,8 +513,8 @@ const Field kSchema[] = {
       "CPU the DDS publisher thread is pinned to (-1 = any)"),
 
     F("queues.imu_capacity", queues.imu_capacity, "1024", "samples", 8, 1048576, "",
-      "IMU queue between the IMU source and the fusion core (drop-oldest; a replay, merged in "
-      "stamp order, uses at most 128 so its streams read the file side by side)"),
+      "IMU queue between the IMU source and the fusion core (drop-oldest; a --max-speed replay, "
+      "merged in stamp order, uses at most 128 so its streams read the file side by side)"),
     F("queues.scan_capacity", queues.scan_capacity, "4", "scans", 2, 64, "",
       "lidar scans between the lidar source and the fusion core (drop-oldest when live)"),
     F("queues.image_capacity", queues.image_capacity, "4", "frames", 2, 64, "",

@@ -33,16 +33,18 @@ std::chrono::nanoseconds block_timeout(const drivers::Source* source) {
                                    : std::chrono::nanoseconds(std::chrono::seconds(1));
 }
 
-/// A replay's IMU queue at most: the fusion stage merges a replay's streams in stamp order, so a
-/// deeper queue buys nothing but lets the IMU's reader run seconds ahead of the other streams',
-/// beyond the chunks they share (McapChunkCache: with 1024 samples half the reads missed). 0.64 s
-/// at the A9's 200 Hz, longer than the scan queue's span.
-constexpr std::size_t kReplayImuCapacity = 128;
+/// A max-speed replay's IMU queue at most: the fusion stage merges its streams in stamp order and
+/// propagates the odometry itself, so a deeper queue buys nothing but lets the IMU's reader run
+/// seconds ahead of the other streams', beyond the chunks they share (McapChunkCache: with 1024
+/// samples half the reads missed). 0.64 s at the A9's 200 Hz, longer than the scan queue's span.
+/// A paced replay keeps the configured depth: there the IMU stage writes the odometry, and its
+/// queue is what lets it run on while a heavy stage stalls (OdometryStallReplay).
+constexpr std::size_t kMaxSpeedReplayImuCapacity = 128;
 
-std::size_t imu_capacity(const config::PosedConfig& c, const drivers::Source* source) {
+std::size_t imu_capacity(const config::PosedConfig& c, const PipelineSources& sources) {
   const auto configured = static_cast<std::size_t>(c.queues.imu_capacity);
-  return source != nullptr && !source->live() ? std::min(configured, kReplayImuCapacity)
-                                              : configured;
+  const bool max_speed_replay = sources.imu != nullptr && !sources.imu->live() && !sources.paced;
+  return max_speed_replay ? std::min(configured, kMaxSpeedReplayImuCapacity) : configured;
 }
 
 /// Lidar-inertial odometry when there is a lidar (also returned as `lio`, for the cameras to
@@ -100,7 +102,7 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
     : config_(config),
       sources_(std::move(sources)),
       outputs_(std::move(outputs)),
-      imu_queue_(imu_capacity(config, sources_.imu.get()), queue_policy(sources_.imu.get()),
+      imu_queue_(imu_capacity(config, sources_), queue_policy(sources_.imu.get()),
                  block_timeout(sources_.imu.get())),
       state_queue_(static_cast<std::size_t>(config.queues.state_capacity),
                    queue_policy(sources_.imu.get()), block_timeout(sources_.imu.get())),
