@@ -2,9 +2,9 @@
 // Where the camera front end's work runs. The core hands it tasks in the order the measurements
 // came and waits for them only where it needs their result (the window step), so the front end
 // can run beside the lidar front end without the core starting a thread (DESIGN.md: threads
-// belong to a runner around the core). InlineLane runs each task at once on the caller's thread;
-// the daemon's CameraLane (daemon/pipeline/camera_lane.hpp) runs them on a thread of its own.
-// Either way the tasks run one after another in the order posted, so the estimate is the same.
+// belong to a runner around the core). The daemon's CameraLane (daemon/pipeline/camera_lane.hpp)
+// runs them on a thread of its own; without a lane the core calls the front end itself. Either
+// way the calls run one after another in measurement order, so the estimate is the same.
 
 #include <functional>
 
@@ -19,12 +19,6 @@ class TaskLane {
   /// Returns once every task posted so far has run; what they wrote is then visible to the
   /// caller.
   virtual void drain() = 0;
-};
-
-class InlineLane final : public TaskLane {
- public:
-  void post(Task task) override { task(); }
-  void drain() override {}
 };
 
 }  // namespace posed::fusion

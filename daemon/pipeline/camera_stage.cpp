@@ -18,8 +18,10 @@ const config::CameraSection& camera_section(const config::PosedConfig& config, C
 
 std::size_t CameraStage::pool_buffers(const config::PosedConfig& config) {
   // The queue, the frame being decoded, and what the fusion core's camera front end may hold:
-  // frames waiting for a partner (3) and pairs waiting for the IMU (up to 6).
-  return static_cast<std::size_t>(config.queues.image_capacity) + 12;
+  // frames waiting for a partner (3) and pairs waiting for the IMU (up to 6), and with the front
+  // end on its own thread (frontend.own_thread) the frames posted to it between two window steps
+  // (a scan period: 2 at 15-25 Hz, 4 to spare).
+  return static_cast<std::size_t>(config.queues.image_capacity) + 16;
 }
 
 std::size_t CameraStage::frame_bytes(const config::CameraSection& section) {
