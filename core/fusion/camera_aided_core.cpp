@@ -69,9 +69,9 @@ void CameraAidedCore::relative_motions(const estimator::SlidingWindow& window,
 }
 
 void CameraAidedCore::after_solve(const estimator::SlidingWindow& window) {
-  // The lane is idle: nothing was posted since the join in relative_motions.
+  // The lane is idle: nothing was posted since the join in relative_motions, and active_ stays
+  // as that join took it (after_solve weighs streams; it does not open or close them).
   factors_->after_solve(window);
-  active_ = factors_->active();
 }
 
 void CameraAidedCore::on_frame(const vision::FrontendFrame& frame,

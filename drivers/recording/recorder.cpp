@@ -247,20 +247,19 @@ void Recorder::run() {
       }
       std::sort(batch.begin(), batch.end(),
                 [](const Pending& a, const Pending& b) { return a.order < b.order; });
-    }
-    for (std::size_t i = 0; i < n && !options_.in_push_order; ++i) {
-      Item item;
-      // Bounded per pass so one busy channel cannot starve the merge order of the others.
-      for (int k = 0; k < 4096 && channels_[i]->queue.try_pop(item); ++k) {
-        batch.push_back(
-            {item.log_time_ns, item.order, static_cast<std::uint16_t>(i), std::move(item.bytes)});
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        Item item;
+        // Bounded per pass so one busy channel cannot starve the merge order of the others.
+        for (int k = 0; k < 4096 && channels_[i]->queue.try_pop(item); ++k) {
+          batch.push_back(
+              {item.log_time_ns, item.order, static_cast<std::uint16_t>(i), std::move(item.bytes)});
+        }
       }
-    }
-    // Queues are drained in batches; ordering each batch by log time keeps the file close to
-    // time order across channels (MCAP does not require it; players prefer it). Equal log times
-    // keep the order they were pushed in: a Source's chunks of one read (a D435i frame's metadata,
-    // then the frame) must replay in that order whatever channel each went to.
-    if (!options_.in_push_order) {
+      // Queues are drained in batches; ordering each batch by log time keeps the file close to
+      // time order across channels (MCAP does not require it; players prefer it). Equal log
+      // times keep the order they were pushed in: a Source's chunks of one read (a D435i frame's
+      // metadata, then the frame) must replay in that order whatever channel each went to.
       std::sort(batch.begin(), batch.end(), [](const Pending& a, const Pending& b) {
         return a.log_time_ns != b.log_time_ns ? a.log_time_ns < b.log_time_ns : a.order < b.order;
       });

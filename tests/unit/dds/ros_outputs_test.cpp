@@ -31,6 +31,13 @@ TEST(PathBuilder, KeepsPosesAStepApartAndThinsTheOldOnesPastTheCap) {
   EXPECT_EQ(builder.path().stamp, pose_at(50.0).stamp);
 }
 
+/// Whether `status` lists `key` with `value`.
+bool has_value(const dds::DiagnosticStatusMessage& status, const std::string& key,
+               const std::string& value) {
+  return std::find(status.values.begin(), status.values.end(),
+                   std::pair<std::string, std::string>{key, value}) != status.values.end();
+}
+
 TEST(RosDiagnostics, StreamHealthBecomesRosLevelsWithFigures) {
   pipeline::PipelineStatus st;
   st.mode = EstimatorMode::kLidarInertial;
@@ -50,9 +57,7 @@ TEST(RosDiagnostics, StreamHealthBecomesRosLevelsWithFigures) {
   EXPECT_EQ(msg.status[2].level, L::kStale);
   EXPECT_EQ(msg.status[3].level, L::kError);
   EXPECT_EQ(msg.status[0].name, "posed: ok");
-  EXPECT_NE(std::find(msg.status[0].values.begin(), msg.status[0].values.end(),
-                      std::pair<std::string, std::string>{"decoded", "7"}),
-            msg.status[0].values.end());
+  EXPECT_TRUE(has_value(msg.status[0], "decoded", "7"));
   EXPECT_EQ(msg.status[4].name, "posed: estimator");
   EXPECT_EQ(msg.status[4].level, L::kOk);
   st.mode = EstimatorMode::kAligning;
@@ -74,16 +79,12 @@ TEST(RosDiagnostics, TheMappingStageIsAWarningUntilLocalised) {
   EXPECT_EQ(d.name, "posed: mapping");
   EXPECT_EQ(d.level, L::kWarn);
   EXPECT_EQ(d.message, "aligning");
-  EXPECT_NE(std::find(d.values.begin(), d.values.end(),
-                      std::pair<std::string, std::string>{"map -> odom", "12.500 m"}),
-            d.values.end());
+  EXPECT_TRUE(has_value(d, "map -> odom", "12.500 m"));
   m.state = "localised";
   m.fixes = 3;
   const L localised = diagnostics(st, WallTime::from_ns(1)).status[1];
   EXPECT_EQ(localised.level, L::kOk);
-  EXPECT_NE(std::find(localised.values.begin(), localised.values.end(),
-                      std::pair<std::string, std::string>{"fixes", "3"}),
-            localised.values.end());
+  EXPECT_TRUE(has_value(localised, "fixes", "3"));
   m.state = "lost";
   EXPECT_EQ(diagnostics(st, WallTime::from_ns(1)).status[1].level, L::kWarn);
   // Closing loops is never a warning by itself.
@@ -92,9 +93,7 @@ TEST(RosDiagnostics, TheMappingStageIsAWarningUntilLocalised) {
   m.loops = 4;
   const L mapping = diagnostics(st, WallTime::from_ns(1)).status[1];
   EXPECT_EQ(mapping.level, L::kOk);
-  EXPECT_NE(std::find(mapping.values.begin(), mapping.values.end(),
-                      std::pair<std::string, std::string>{"loops", "4"}),
-            mapping.values.end());
+  EXPECT_TRUE(has_value(mapping, "loops", "4"));
 }
 
 TEST(RosStaticTransforms, ThermalIsTheCameraExtrinsicChainedWithCameraToThermal) {
