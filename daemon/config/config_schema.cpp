@@ -507,14 +507,20 @@ const Field kSchema[] = {
       "SCHED_FIFO priority of the camera source threads (0 = normal scheduling)"),
     F("threads.camera_source.cpu", threads.camera_source.cpu, "-1", "", -1, 1023, "",
       "CPU the camera source threads are pinned to (-1 = any)"),
+    F("threads.camera_frontend.priority", threads.camera_frontend.priority, "0", "", 0, 50, "",
+      "SCHED_FIFO priority of the camera front end's thread, posed-camera (frontend.own_thread; "
+      "0 = normal scheduling)"),
+    F("threads.camera_frontend.cpu", threads.camera_frontend.cpu, "-1", "", -1, 1023, "",
+      "CPU the camera front end's thread is pinned to (-1 = any); it works beside the fusion "
+      "thread, so not the fusion thread's CPU"),
     F("threads.publisher.priority", threads.publisher.priority, "0", "", 0, 50, "",
       "SCHED_FIFO priority of the DDS publisher thread (0 = normal scheduling)"),
     F("threads.publisher.cpu", threads.publisher.cpu, "-1", "", -1, 1023, "",
       "CPU the DDS publisher thread is pinned to (-1 = any)"),
 
     F("queues.imu_capacity", queues.imu_capacity, "1024", "samples", 8, 1048576, "",
-      "IMU queue between the IMU source and the fusion core (drop-oldest; a --max-speed replay, "
-      "merged in stamp order, uses at most 128 so its streams read the file side by side)"),
+      "each IMU's queue (the A9's, the D435i's) to the fusion core (drop-oldest; a --max-speed "
+      "replay, merged in stamp order, uses at most 128 so its streams read the file side by side)"),
     F("queues.scan_capacity", queues.scan_capacity, "4", "scans", 2, 64, "",
       "lidar scans between the lidar source and the fusion core (drop-oldest when live)"),
     F("queues.image_capacity", queues.image_capacity, "4", "frames", 2, 64, "",

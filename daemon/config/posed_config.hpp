@@ -261,6 +261,7 @@ struct ThreadsSection {
   ThreadSection lidar_source;
   ThreadSection fusion;
   ThreadSection camera_source;
+  ThreadSection camera_frontend;  ///< posed-camera: the camera front end (frontend.own_thread)
   ThreadSection publisher;
 };
 

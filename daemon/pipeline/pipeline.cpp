@@ -33,17 +33,20 @@ std::chrono::nanoseconds block_timeout(const drivers::Source* source) {
                                    : std::chrono::nanoseconds(std::chrono::seconds(1));
 }
 
-/// A max-speed replay's IMU queue at most: the fusion stage merges its streams in stamp order and
-/// propagates the odometry itself, so a deeper queue buys nothing but lets the IMU's reader run
+/// A max-speed replay's IMU queues at most: the fusion stage merges its streams in stamp order and
+/// propagates the odometry itself, so a deeper queue buys nothing but lets an IMU's reader run
 /// seconds ahead of the other streams', beyond the chunks they share (McapChunkCache: with 1024
-/// samples half the reads missed). 0.64 s at the A9's 200 Hz, longer than the scan queue's span.
+/// samples half the reads missed). 0.64 s at 200 Hz (the A9's, and the D435i's one sample per
+/// gyro reading), longer than the scan queue's span.
 /// A paced replay keeps the configured depth: there the IMU stage writes the odometry, and its
 /// queue is what lets it run on while a heavy stage stalls (OdometryStallReplay).
 constexpr std::size_t kMaxSpeedReplayImuCapacity = 128;
 
-std::size_t imu_capacity(const config::PosedConfig& c, const PipelineSources& sources) {
+/// The queue of one IMU source (the A9's or the D435i's).
+std::size_t imu_capacity(const config::PosedConfig& c, const PipelineSources& sources,
+                         const drivers::Source* imu) {
   const auto configured = static_cast<std::size_t>(c.queues.imu_capacity);
-  const bool max_speed_replay = sources.imu != nullptr && !sources.imu->live() && !sources.paced;
+  const bool max_speed_replay = imu != nullptr && !imu->live() && !sources.paced;
   return max_speed_replay ? std::min(configured, kMaxSpeedReplayImuCapacity) : configured;
 }
 
@@ -85,7 +88,7 @@ std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
     }
   }
   if (c.frontend.own_thread && lio != nullptr) {
-    lane = std::make_unique<CameraLane>(c.threads.fusion);
+    lane = std::make_unique<CameraLane>(c.threads.camera_frontend);
   }
   auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras, factors, lio,
                                                         lane.get());
@@ -102,8 +105,8 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
     : config_(config),
       sources_(std::move(sources)),
       outputs_(std::move(outputs)),
-      imu_queue_(imu_capacity(config, sources_), queue_policy(sources_.imu.get()),
-                 block_timeout(sources_.imu.get())),
+      imu_queue_(imu_capacity(config, sources_, sources_.imu.get()),
+                 queue_policy(sources_.imu.get()), block_timeout(sources_.imu.get())),
       state_queue_(static_cast<std::size_t>(config.queues.state_capacity),
                    queue_policy(sources_.imu.get()), block_timeout(sources_.imu.get())),
       scan_counters_(std::make_unique<LidarScanCounters>()),
@@ -115,7 +118,7 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
   }
   if (sources_.realsense_imu && config.realsense_imu.failover) {
     backup_imu_queue_ = std::make_unique<SpscQueue<ImuItem>>(
-        static_cast<std::size_t>(config.queues.imu_capacity),
+        imu_capacity(config, sources_, sources_.realsense_imu.get()),
         queue_policy(sources_.realsense_imu.get()), block_timeout(sources_.realsense_imu.get()));
   }
   for (const CameraStream s : kCameraStreams) {
