@@ -6,8 +6,11 @@
 
 namespace posed::pipeline {
 
-CameraLane::CameraLane(const config::ThreadSection& policy, std::size_t capacity)
-    : capacity_(capacity > 0 ? capacity : 1), thread_([this, policy] { run(policy); }) {}
+CameraLane::CameraLane(const config::ThreadSection& policy, std::size_t capacity,
+                       Heartbeat* heartbeat)
+    : capacity_(capacity > 0 ? capacity : 1),
+      heartbeat_(heartbeat),
+      thread_([this, policy] { run(policy); }) {}
 
 CameraLane::~CameraLane() {
   {
@@ -44,8 +47,14 @@ CameraLaneCounters CameraLane::counters() const {
 void CameraLane::run(config::ThreadSection policy) {
   apply_thread_policy("posed-camera", policy);
   std::unique_lock lock(mutex_);
+  const auto beat = [this] {
+    if (heartbeat_ != nullptr) heartbeat_->beat();
+  };
   for (;;) {
-    work_.wait(lock, [&] { return !tasks_.empty() || stopping_; });
+    beat();
+    if (!work_.wait_for(lock, kStageWaitTimeout, [&] { return !tasks_.empty() || stopping_; })) {
+      continue;  // idle: beat again
+    }
     if (tasks_.empty()) break;  // stopping, and everything posted has run
     Task task = std::move(tasks_.front());
     tasks_.pop_front();
@@ -54,6 +63,7 @@ void CameraLane::run(config::ThreadSection policy) {
     room_.notify_one();
     task();
     task = nullptr;  // what it held (an image's pool buffer) goes back now, not at the next task
+    beat();
     lock.lock();
     running_task_ = false;
     ++counters_.tasks;

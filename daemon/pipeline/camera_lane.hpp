@@ -14,6 +14,7 @@
 
 #include "core/fusion/task_lane.hpp"
 #include "daemon/config/posed_config.hpp"
+#include "daemon/pipeline/stage_support.hpp"
 
 namespace posed::pipeline {
 
@@ -25,8 +26,12 @@ struct CameraLaneCounters {
 
 class CameraLane final : public fusion::TaskLane {
  public:
-  /// Starts the thread ("posed-camera") under `policy`.
-  explicit CameraLane(const config::ThreadSection& policy, std::size_t capacity = 256);
+  /// Starts the thread ("posed-camera") under `policy`. `heartbeat` (optional; it must outlive
+  /// the lane) beats while the lane waits for work and before and after each task, so a task
+  /// that hangs stops it: the watchdog then names the camera front end, not only the fusion
+  /// stage that waits for it in drain().
+  explicit CameraLane(const config::ThreadSection& policy, std::size_t capacity = 256,
+                      Heartbeat* heartbeat = nullptr);
   /// Runs what is still posted, then ends the thread.
   ~CameraLane() override;
   CameraLane(const CameraLane&) = delete;
@@ -40,6 +45,7 @@ class CameraLane final : public fusion::TaskLane {
   void run(config::ThreadSection policy);
 
   const std::size_t capacity_;
+  Heartbeat* const heartbeat_;
   mutable std::mutex mutex_;
   std::condition_variable work_;  // a task was posted, or stopping
   std::condition_variable room_;  // a task was taken

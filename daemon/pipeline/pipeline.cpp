@@ -71,7 +71,7 @@ std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
                                          estimator::LioEstimator* lio, const config::PosedConfig& c,
                                          bool has_visible, bool has_thermal, bool in_stamp_order,
                                          const PipelineOutputs& outputs,
-                                         std::unique_ptr<CameraLane>& lane,
+                                         std::unique_ptr<CameraLane>& lane, Heartbeat& lane_beat,
                                          const fusion::CameraAidedCore*& camera_core) {
   camera_core = nullptr;
   if ((!has_visible && !has_thermal) || c.frontend.mode == "off") return inner;
@@ -88,7 +88,7 @@ std::unique_ptr<FusionCore> with_cameras(std::unique_ptr<FusionCore> inner,
     }
   }
   if (c.frontend.own_thread && lio != nullptr) {
-    lane = std::make_unique<CameraLane>(c.threads.camera_frontend);
+    lane = std::make_unique<CameraLane>(c.threads.camera_frontend, 256, &lane_beat);
   }
   auto core = std::make_unique<fusion::CameraAidedCore>(std::move(inner), cameras, factors, lio,
                                                         lane.get());
@@ -146,6 +146,7 @@ void Pipeline::add_stage(std::string name,
 std::vector<std::string> Pipeline::stage_names() const {
   std::vector<std::string> names;
   for (const auto& stage : stages_) names.push_back(stage.heartbeat->name());
+  if (camera_lane_) names.push_back(camera_lane_beat_.name());
   return names;
 }
 
@@ -154,6 +155,7 @@ std::vector<StageBeat> Pipeline::stage_heartbeats() const {
   for (const auto& stage : stages_) {
     beats.push_back(StageBeat{stage.heartbeat->name(), stage.heartbeat->last()});
   }
+  if (camera_lane_) beats.push_back(StageBeat{camera_lane_beat_.name(), camera_lane_beat_.last()});
   return beats;
 }
 
@@ -225,7 +227,7 @@ bool Pipeline::start(std::string& error) {
       make_core(config_, sources_.lidar != nullptr, outputs_.keep_map, lio);
   core = with_cameras(std::move(core), lio, config_, sources_.visible != nullptr,
                       sources_.thermal != nullptr, in_stamp_order, outputs_, camera_lane_,
-                      camera_core_);
+                      camera_lane_beat_, camera_core_);
   // Odometry apart from the back end needs a back end with optimised states to anchor on (the
   // lidar-inertial one); IMU-only dead reckoning is itself the cheap propagation.
   OdometryHandover handover;
@@ -316,6 +318,7 @@ bool Pipeline::start(std::string& error) {
   cv::setNumThreads(0);
   const HostTime now = drivers::host_now();
   for (auto& stage : stages_) stage.heartbeat->reset(now);
+  camera_lane_beat_.reset(now);
   started_ = true;
   for (auto& stage : stages_) launch(stage.run);
   return true;

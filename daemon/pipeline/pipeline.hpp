@@ -141,7 +141,8 @@ class Pipeline {
   void request_stop();
   /// True once every stage thread has finished.
   bool finished() const { return started_ && finished_stages_.load() == stages_.size(); }
-  /// The stages this pipeline runs (the lidar stage only with a lidar Source).
+  /// The stages this pipeline runs (the lidar stage only with a lidar Source), then the camera
+  /// front end's thread when it has one (camera_frontend; known once start() has built the core).
   std::vector<std::string> stage_names() const;
   /// Joins the threads (call after finished() or request_stop()).
   void join();
@@ -214,8 +215,9 @@ class Pipeline {
   std::unique_ptr<RealsenseImuStage> realsense_imu_stage_;
   std::unique_ptr<LidarStage> lidar_stage_;
   std::unique_ptr<CameraStage> camera_stages_[2];
-  /// the camera front end's thread (frontend.own_thread); declared before the fusion stage,
-  /// whose core posts to it, so it outlives that core
+  /// the camera front end's thread (frontend.own_thread) and its heartbeat; declared before the
+  /// fusion stage, whose core posts to it, so it outlives that core
+  Heartbeat camera_lane_beat_{"camera_frontend"};
   std::unique_ptr<CameraLane> camera_lane_;
   std::unique_ptr<FusionStage> fusion_stage_;
   /// the fusion core when it has cameras (owned by fusion_stage_)

@@ -1,7 +1,8 @@
 // The camera front end's lane (CameraLane): tasks run one after another in the order posted, on
 // a thread that is not the poster's; drain() returns only once everything posted has run and its
 // writes are visible; a full lane makes the poster wait instead of dropping; what is still posted
-// when the lane is destroyed runs first.
+// when the lane is destroyed runs first; its heartbeat goes on while it waits for work and stops
+// while a task hangs.
 
 #include "daemon/pipeline/camera_lane.hpp"
 
@@ -9,6 +10,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <future>
 #include <thread>
 #include <vector>
 
@@ -60,6 +62,34 @@ TEST(CameraLane, WhatIsPostedRunsBeforeTheLaneEnds) {
     }
   }
   EXPECT_EQ(ran, 50);
+}
+
+TEST(CameraLane, BeatsWhileIdleAndNotWhileATaskHangs) {
+  using namespace std::chrono_literals;
+  Heartbeat beat("camera_frontend");
+  CameraLane lane(config::ThreadSection{}, 8, &beat);
+  const auto wait_for_beat_after = [&beat](std::int64_t ns) {
+    for (int i = 0; i < 400 && beat.last().ns <= ns; ++i) std::this_thread::sleep_for(5ms);
+    return beat.last().ns > ns;
+  };
+  ASSERT_TRUE(wait_for_beat_after(0)) << "the lane never beat";
+  // Idle, it beats again within kStageWaitTimeout (50 ms); 2 s is the margin for a slow machine.
+  EXPECT_TRUE(wait_for_beat_after(beat.last().ns)) << "no beat while idle";
+
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::atomic<bool> started{false};
+  lane.post([&started, released] {
+    started = true;
+    released.wait();
+  });
+  while (!started) std::this_thread::yield();
+  const std::int64_t before = beat.last().ns;
+  std::this_thread::sleep_for(300ms);  // six idle periods
+  EXPECT_EQ(beat.last().ns, before) << "the lane beat while its task hung";
+  release.set_value();
+  lane.drain();
+  EXPECT_TRUE(wait_for_beat_after(before)) << "no beat after the task ended";
 }
 
 }  // namespace
