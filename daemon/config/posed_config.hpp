@@ -200,6 +200,7 @@ struct FrontendSection {
   int max_features = 300;
   double min_feature_distance_px = 20;  ///< [px]
   double ransac_threshold_px = 4;       ///< [px]
+  double forward_backward_px = 0.5;     ///< KLT round-trip error allowed [px]
   bool lines = false;
   double depth_window_s = 1;  ///< [s]
   int depth_points_per_scan = 20000;
