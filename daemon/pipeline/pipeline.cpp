@@ -42,11 +42,10 @@ std::chrono::nanoseconds block_timeout(const drivers::Source* source) {
 /// queue is what lets it run on while a heavy stage stalls (OdometryStallReplay).
 constexpr std::size_t kMaxSpeedReplayImuCapacity = 128;
 
-/// The queue of one IMU source (the A9's or the D435i's).
-std::size_t imu_capacity(const config::PosedConfig& c, const PipelineSources& sources,
-                         const drivers::Source* imu) {
+/// The queue of one IMU source (the A9's or the D435i's); `paced`: a replay at recorded timing.
+std::size_t imu_capacity(const config::PosedConfig& c, const drivers::Source* imu, bool paced) {
   const auto configured = static_cast<std::size_t>(c.queues.imu_capacity);
-  const bool max_speed_replay = imu != nullptr && !imu->live() && !sources.paced;
+  const bool max_speed_replay = imu != nullptr && !imu->live() && !paced;
   return max_speed_replay ? std::min(configured, kMaxSpeedReplayImuCapacity) : configured;
 }
 
@@ -105,7 +104,7 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
     : config_(config),
       sources_(std::move(sources)),
       outputs_(std::move(outputs)),
-      imu_queue_(imu_capacity(config, sources_, sources_.imu.get()),
+      imu_queue_(imu_capacity(config, sources_.imu.get(), sources_.paced),
                  queue_policy(sources_.imu.get()), block_timeout(sources_.imu.get())),
       state_queue_(static_cast<std::size_t>(config.queues.state_capacity),
                    queue_policy(sources_.imu.get()), block_timeout(sources_.imu.get())),
@@ -118,7 +117,7 @@ Pipeline::Pipeline(const config::PosedConfig& config, PipelineSources sources,
   }
   if (sources_.realsense_imu && config.realsense_imu.failover) {
     backup_imu_queue_ = std::make_unique<SpscQueue<ImuItem>>(
-        imu_capacity(config, sources_, sources_.realsense_imu.get()),
+        imu_capacity(config, sources_.realsense_imu.get(), sources_.paced),
         queue_policy(sources_.realsense_imu.get()), block_timeout(sources_.realsense_imu.get()));
   }
   for (const CameraStream s : kCameraStreams) {
@@ -145,8 +144,7 @@ void Pipeline::add_stage(std::string name,
 
 std::vector<std::string> Pipeline::stage_names() const {
   std::vector<std::string> names;
-  for (const auto& stage : stages_) names.push_back(stage.heartbeat->name());
-  if (camera_lane_) names.push_back(camera_lane_beat_.name());
+  for (const StageBeat& beat : stage_heartbeats()) names.push_back(beat.name);
   return names;
 }
 

@@ -122,7 +122,8 @@ struct PipelineOutputs {
 
 /// One stage's last sign of life, for the systemd watchdog.
 struct StageBeat {
-  /// "imu_source", "lidar_source", "visible_source", "mapping", "fusion", "publisher"
+  /// "imu_source", "lidar_source", "visible_source", "mapping", "fusion", "publisher",
+  /// "camera_frontend"
   std::string name;
   HostTime last;
 };
