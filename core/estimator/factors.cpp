@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 
 #include "core/estimator/pose_manifold.hpp"
 #include "core/math/so3.hpp"
@@ -178,6 +179,61 @@ bool RelativePoseFactor::Evaluate(double const* const* parameters, double* resid
     J.block<3, 3>(0, 3) = Jr_inv;
     J.block<3, 3>(3, 0) = Rm_T * Ri.transpose();
     pose_jacobian<6>(sqrt_info_ * J, parameters[1], jacobians[1]);
+  }
+  return true;
+}
+
+LandmarkFactor::LandmarkFactor(const Eigen::Vector3d& X_a, const Eigen::Isometry3d& T_body_cam,
+                               const Eigen::Vector2d& observed_normalised, double sqrt_information)
+    : X_a_(X_a),
+      R_bc_T_(T_body_cam.linear().transpose()),
+      t_bc_(T_body_cam.translation()),
+      observed_(observed_normalised),
+      sqrt_information_(sqrt_information) {}
+
+Eigen::Vector3d LandmarkFactor::point_in_camera(const Eigen::Isometry3d& T_map_a,
+                                                const Eigen::Isometry3d& T_map_j) const {
+  const Eigen::Vector3d P_j = T_map_j.inverse() * (T_map_a * X_a_);
+  return R_bc_T_ * (P_j - t_bc_);
+}
+
+bool LandmarkFactor::Evaluate(double const* const* parameters, double* residuals,
+                              double** jacobians) const {
+  const Eigen::Map<const Eigen::Vector3d> pa(parameters[0]), pj(parameters[1]);
+  const Mat3 Ra =
+      Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized().toRotationMatrix();
+  const Mat3 Rj =
+      Eigen::Map<const Eigen::Quaterniond>(parameters[1] + 3).normalized().toRotationMatrix();
+  const Eigen::Vector3d P_map = Ra * X_a_ + pa;
+  const Eigen::Vector3d P_j = Rj.transpose() * (P_map - pj);  // in state j's body
+  const Eigen::Vector3d P_c = R_bc_T_ * (P_j - t_bc_);        // in the observing camera
+  // Behind (or at) the camera: a large constant residual, no gradient (Huber caps its weight).
+  if (P_c.z() < 1e-3) {
+    residuals[0] = residuals[1] = sqrt_information_;
+    for (int k = 0; k < 2; ++k) {
+      if (jacobians != nullptr && jacobians[k] != nullptr) std::fill_n(jacobians[k], 14, 0.0);
+    }
+    return true;
+  }
+  const double inv_z = 1.0 / P_c.z();
+  Eigen::Map<Eigen::Vector2d> r(residuals);
+  r = sqrt_information_ * (P_c.head<2>() * inv_z - observed_);
+  if (jacobians == nullptr) return true;
+  Eigen::Matrix<double, 2, 3> d_proj;
+  d_proj << inv_z, 0, -P_c.x() * inv_z * inv_z, 0, inv_z, -P_c.y() * inv_z * inv_z;
+  const Eigen::Matrix<double, 2, 3> d_Pj = sqrt_information_ * d_proj * R_bc_T_;
+  if (jacobians[0] != nullptr) {  // pose a: dP_map = dp + Ra (dtheta x X_a)
+    Eigen::Matrix<double, 2, 6> J;
+    const Eigen::Matrix<double, 2, 3> d_Pmap = d_Pj * Rj.transpose();
+    J.leftCols<3>() = d_Pmap;
+    J.rightCols<3>() = -d_Pmap * Ra * skew(X_a_);
+    pose_jacobian<2>(J, parameters[0], jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {  // pose j: dP_j = -Rjᵀ dp + skew(P_j) dtheta
+    Eigen::Matrix<double, 2, 6> J;
+    J.leftCols<3>() = -d_Pj * Rj.transpose();
+    J.rightCols<3>() = d_Pj * skew(P_j);
+    pose_jacobian<2>(J, parameters[1], jacobians[1]);
   }
   return true;
 }

@@ -67,6 +67,31 @@ class RelativePoseFactor final : public ceres::SizedCostFunction<6, 7, 7> {
   Eigen::Matrix<double, 6, 6> sqrt_info_;
 };
 
+/// A landmark seen by a camera from two states (LVI-SAM's VIS, VINS-Mono's projection factor with
+/// the depth held at the lidar's): the point X_a, fixed in the body frame of anchor state a where
+/// it was first seen with lidar depth, must project onto its observation in a later frame of
+/// state j. 2 residuals, the normalised image coordinates' error times `sqrt_information`
+/// (focal length over pixel sigma): r = s ((x, y) / z - u) with (x, y, z) = T_body_cam⁻¹
+/// T_map_j⁻¹ T_map_a X_a. T_body_cam is the camera of the observing frame in state j's body
+/// (the extrinsic, and the short bridge from the frame's stamp to the state's).
+class LandmarkFactor final : public ceres::SizedCostFunction<2, 7, 7> {
+ public:
+  LandmarkFactor(const Eigen::Vector3d& X_a, const Eigen::Isometry3d& T_body_cam,
+                 const Eigen::Vector2d& observed_normalised, double sqrt_information);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+  /// The landmark in the observing camera at poses a and j (for checks before a factor is added).
+  Eigen::Vector3d point_in_camera(const Eigen::Isometry3d& T_map_a,
+                                  const Eigen::Isometry3d& T_map_j) const;
+
+ private:
+  Eigen::Vector3d X_a_;
+  Eigen::Matrix3d R_bc_T_;
+  Eigen::Vector3d t_bc_;
+  Eigen::Vector2d observed_;
+  double sqrt_information_;
+};
+
 /// The square root of a (possibly singular) information matrix: S with Sᵀ S = information.
 Eigen::Matrix<double, 6, 6> sqrt_information(const Eigen::Matrix<double, 6, 6>& information);
 

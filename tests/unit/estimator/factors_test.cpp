@@ -6,6 +6,9 @@
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/estimator/pose_manifold.hpp"
 #include "tests/unit/estimator/analytic_motion.hpp"
 
@@ -123,6 +126,63 @@ TEST(Factors, RelativePoseFactorJacobiansMatchNumericDifferentiation) {
   ceres::GradientChecker::ProbeResults results;
   checker.Probe(params, 1e-6, &results);
   expect_jacobians_match(results, 1e-6);
+}
+
+TEST(Factors, LandmarkFactorJacobiansMatchNumericDifferentiation) {
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+  T_body_cam.linear() = so3::exp(Eigen::Vector3d(-1.5, 0.05, -1.55));  // looking ahead, z forward
+  T_body_cam.translation() = Eigen::Vector3d(0.1, 0.02, 0.05);
+  const LandmarkFactor factor(Eigen::Vector3d(4.0, 0.6, 0.3), T_body_cam,
+                              Eigen::Vector2d(0.03, -0.02), 600.0);
+  imu::ImuState a, j;
+  a.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.02, -0.01, 0.45)));
+  a.p_map_imu_m = Eigen::Vector3d(3.1, -2.2, 0.4);
+  j.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.01, 0.02, 0.5)));
+  j.p_map_imu_m = Eigen::Vector3d(3.6, -1.9, 0.42);
+  double pose_a[7], pose_j[7], sb[9];
+  state_arrays(a, pose_a, sb);
+  state_arrays(j, pose_j, sb);
+  double r[2];
+  const double* params[] = {pose_a, pose_j};
+  ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
+  EXPECT_GT(std::hypot(r[0], r[1]), 1.0);  // away from the measurement: every term counts
+  PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, &pose_manifold};
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, 1e-6, &results);
+  expect_jacobians_match(results, 1e-5);
+}
+
+TEST(Factors, LandmarkFactorIsZeroWhereThePointProjectsOntoItsObservation) {
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+  T_body_cam.linear() = so3::exp(Eigen::Vector3d(-1.5, 0.05, -1.55));
+  T_body_cam.translation() = Eigen::Vector3d(0.1, 0.02, 0.05);
+  Eigen::Isometry3d T_map_a = Eigen::Isometry3d::Identity(), T_map_j = T_map_a;
+  T_map_a.linear() = so3::exp(Eigen::Vector3d(0.0, 0.0, 0.3));
+  T_map_j.linear() = so3::exp(Eigen::Vector3d(0.0, 0.01, 0.35));
+  T_map_j.translation() = Eigen::Vector3d(0.4, 0.1, 0.0);
+  const Eigen::Vector3d X_a(5.0, -0.4, 0.7);
+  const Eigen::Vector3d P_c = (T_map_j * T_body_cam).inverse() * (T_map_a * X_a);
+  const LandmarkFactor factor(X_a, T_body_cam, P_c.head<2>() / P_c.z(), 600.0);
+  EXPECT_LT((factor.point_in_camera(T_map_a, T_map_j) - P_c).norm(), 1e-12);
+  double pose_a[7], pose_j[7], r[2];
+  for (int k = 0; k < 3; ++k) {
+    pose_a[k] = T_map_a.translation()[k];
+    pose_j[k] = T_map_j.translation()[k];
+  }
+  const Eigen::Quaterniond qa(T_map_a.linear()), qj(T_map_j.linear());
+  std::copy_n(qa.coeffs().data(), 4, pose_a + 3);
+  std::copy_n(qj.coeffs().data(), 4, pose_j + 3);
+  const double* params[] = {pose_a, pose_j};
+  ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
+  EXPECT_NEAR(r[0], 0.0, 1e-9);
+  EXPECT_NEAR(r[1], 0.0, 1e-9);
+  // One metre further along the camera's view the point projects elsewhere.
+  pose_j[2] += 1.0;
+  ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
+  EXPECT_GT(std::hypot(r[0], r[1]), 1.0);
 }
 
 TEST(Factors, RelativePoseFactorIsZeroAtTheMeasuredMotion) {

@@ -91,5 +91,88 @@ TEST(Marginalisation, AFixedLagWindowWithCameraFactorsEndsWhereTheBatchSolveEnds
   EXPECT_LT(windowed.q_map_imu.angularDistance(batch.q_map_imu), 1e-3);
 }
 
+/// The same with landmark reprojection factors instead of between factors: every state sees 8
+/// new points (their anchor, where their depth is known to 2 %) and observes each again from the
+/// next 3 states with 1 px of noise, so a landmark's factors all lie within a window of 4 and both
+/// runs solve the same problem.
+imu::ImuState run_landmark_window(int size, int steps) {
+  const test::AnalyticMotion m;
+  const imu::ImuNoise noise_density = {2e-3, 2e-2, 1e-5, 1e-3};
+  SlidingWindowConfig c;
+  c.size = size;
+  c.max_iterations = 30;
+  c.gravity_mps2 = m.gravity_mps2;
+  SlidingWindow w(c);
+  std::mt19937 rng(13);
+  std::normal_distribution<double> n01(0, 1);
+  std::uniform_real_distribution<double> ahead(3, 8), side(-2, 2), up(-1, 1);
+  Eigen::Matrix<double, 15, 1> sigma;
+  sigma << Eigen::Vector3d::Constant(1e-3), Eigen::Vector3d::Constant(1e-3),
+      Eigen::Vector3d::Constant(0.05), Eigen::Vector3d::Constant(1e-3),
+      Eigen::Vector3d::Constant(0.02);
+  w.reset(m.state(0.0), sigma);
+  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+  T_body_cam.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // camera z along body x
+  T_body_cam.translation() = Eigen::Vector3d(0.2, 0.0, 0.3);
+  constexpr double kFocalPx = 600;
+  struct Point {
+    std::uint64_t anchor_id;
+    int anchor_step;
+    Eigen::Vector3d X_anchor_true, X_anchor_measured;
+  };
+  std::vector<Point> points;
+  for (int k = 1; k <= steps; ++k) {
+    const double t = k * kMargStep;
+    const imu::ImuState prev = w.latest();
+    imu::Preintegration pre(noise_density, prev.bias, prev.stamp);
+    for (int i = 0; i <= static_cast<int>(std::lround(kMargStep * kMargImuHz)); ++i) {
+      ImuSample s = m.sample(t - kMargStep + i / kMargImuHz);
+      for (int a = 0; a < 3; ++a) {
+        s.angular_velocity_radps[a] +=
+            noise_density.gyro_noise_density * std::sqrt(kMargImuHz) * n01(rng);
+        s.specific_force_mps2[a] +=
+            noise_density.accel_noise_density * std::sqrt(kMargImuHz) * n01(rng);
+      }
+      pre.add(s);
+    }
+    imu::ImuState guess = pre.predict(prev, m.gravity_mps2);
+    guess.stamp = m.state(t).stamp;
+    w.add(guess, pre, std::nullopt);
+    const Eigen::Isometry3d T_map_j = marg_pose_of(m.state(t));
+    for (const Point& p : points) {
+      if (k - p.anchor_step > 3) continue;
+      const Eigen::Vector3d P_c =
+          (T_map_j * T_body_cam).inverse() *
+          (marg_pose_of(m.state(p.anchor_step * kMargStep)) * p.X_anchor_true);
+      const Eigen::Vector2d observed =
+          P_c.hnormalized() + Eigen::Vector2d(n01(rng), n01(rng)) / kFocalPx;
+      EXPECT_TRUE(w.add_factor(
+          FactorKind::kVisible,
+          std::make_unique<LandmarkFactor>(p.X_anchor_measured, T_body_cam, observed, kFocalPx),
+          {{p.anchor_id, BlockRole::kPose}, {w.latest_id(), BlockRole::kPose}}));
+    }
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d X(ahead(rng), side(rng), up(rng));
+      points.push_back({w.latest_id(), k, X, X * (1.0 + 0.02 * n01(rng))});
+    }
+    EXPECT_TRUE(w.solve());
+  }
+  return w.latest();
+}
+
+TEST(Marginalisation, AFixedLagWindowWithLandmarkFactorsEndsWhereTheBatchSolveEnds) {
+  const int steps = 30;
+  const imu::ImuState batch = run_landmark_window(steps + 1, steps);
+  const imu::ImuState windowed = run_landmark_window(4, steps);
+  const imu::ImuState truth = test::AnalyticMotion().state(steps * kMargStep);
+  const double batch_error = (batch.p_map_imu_m - truth.p_map_imu_m).norm();
+  const double difference = (windowed.p_map_imu_m - batch.p_map_imu_m).norm();
+  std::printf("landmarks: batch error %.4f m, windowed - batch %.5f m\n", batch_error, difference);
+  EXPECT_GT(batch_error, 0.005);
+  EXPECT_LT(difference, 0.1 * batch_error);
+  EXPECT_LT((windowed.v_map_mps - batch.v_map_mps).norm(), 0.01);
+  EXPECT_LT(windowed.q_map_imu.angularDistance(batch.q_map_imu), 1e-3);
+}
+
 }  // namespace
 }  // namespace posed::estimator
