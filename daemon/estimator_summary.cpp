@@ -15,6 +15,26 @@ void print_visual_summary(const FusionFigures& f) {
                   modality_names(f.modalities).c_str());
     }
     any = true;
+    if (v.landmarks) {
+      std::printf(
+          "  %-7s factors     %llu landmark reprojections from %llu frames (%llu landmarks "
+          "anchored, %llu in the window now; %llu dropped as holding still, %llu after a solve, "
+          "%llu observations gated); gate %s (left %llu, rejoined %llu times, %llu intervals gated "
+          "out); %llu without frames; last omega %.2f, confidence %.2f, window residual median "
+          "%.2f sigma, residual scale %.1f\n",
+          kStreams[i], static_cast<unsigned long long>(v.factors),
+          static_cast<unsigned long long>(v.frames),
+          static_cast<unsigned long long>(v.landmarks_anchored),
+          static_cast<unsigned long long>(v.landmarks_tracked),
+          static_cast<unsigned long long>(v.landmarks_still),
+          static_cast<unsigned long long>(v.landmarks_outliers),
+          static_cast<unsigned long long>(v.landmarks_gated), v.active ? "open" : "closed",
+          static_cast<unsigned long long>(v.left), static_cast<unsigned long long>(v.rejoined),
+          static_cast<unsigned long long>(v.gated_out),
+          static_cast<unsigned long long>(v.no_frames), v.omega, v.confidence, v.residual_median,
+          v.residual_scale);
+      continue;
+    }
     std::printf(
         "  %-7s factors     %llu between factors (%llu from a keyframe) from %llu frames; gate %s "
         "(left %llu, rejoined %llu times, %llu intervals gated out); %llu without frames, %llu "

@@ -89,6 +89,14 @@ struct VisualStreamFigures {
   double residual_median = 0;
   /// covariance scale from its residuals (CameraFactorsConfig::residual_scaling) [-]
   double residual_scale = 1;
+  /// its features enter as landmarks (a reprojection factor per observation, counted in
+  /// `factors`) instead of between factors; then:
+  bool landmarks = false;
+  std::uint64_t landmarks_anchored = 0;  ///< landmarks created (a feature with lidar depth) [1]
+  std::uint64_t landmarks_still = 0;     ///< dropped as holding still in the image [1]
+  std::uint64_t landmarks_gated = 0;     ///< observations too far from the window's estimate [1]
+  std::uint64_t landmarks_outliers = 0;  ///< dropped after a solve [1]
+  std::uint64_t landmarks_tracked = 0;   ///< landmarks whose anchor is in the window now [1]
 };
 
 /// Seed 001's adaptive pose selection: which odometry gave each state its initial value.

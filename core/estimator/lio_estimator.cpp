@@ -476,6 +476,7 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
                   : m.kind == FactorKind::kThermal ? kModalityThermal
                                                    : kModalityFused;
   }
+  if (aiding_ != nullptr) modalities |= aiding_->add_factors(window_);
   window_.solve();
   if (aiding_ != nullptr) aiding_->after_solve(window_);
   figures_.modalities = modalities;

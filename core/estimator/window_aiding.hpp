@@ -6,6 +6,7 @@
 // choosing the state's initial value (seed 001's adaptive pose selection).
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <vector>
 
 #include "core/estimator/sliding_window.hpp"
@@ -44,6 +45,13 @@ class WindowAiding {
   /// Whether it expects to add motions for the next state (e.g. a camera whose images are good
   /// enough): the lidar then leaves its weakly constrained directions to it.
   virtual bool active() const = 0;
+  /// Adds factors of its own to the window after the new state joined it (the newest state),
+  /// before the solve (e.g. a camera's landmark reprojections). Returns the Modality bits of
+  /// what it added.
+  virtual std::uint8_t add_factors(SlidingWindow& window) {
+    (void)window;
+    return 0;
+  }
   /// Called after every solve with the window as optimised (e.g. for residual statistics).
   virtual void after_solve(const SlidingWindow& window) { (void)window; }
 };

@@ -30,8 +30,13 @@ CameraAidedCore::CameraAidedCore(std::unique_ptr<FusionCore> inner,
   description_ = std::string(inner_->description()) + " with the " +
                  std::string(vision::to_string(cameras.frontend.mode)) + " camera front end";
   if (lane_ != nullptr) description_ += " on a thread of its own";
-  description_ += factors_ ? " (" + streams + " motion in the window, weighed by image quality)"
-                           : " (features, quality and lidar depth; not in the estimate)";
+  if (!factors_) {
+    description_ += " (features, quality and lidar depth; not in the estimate)";
+  } else if (factors.coupling != CameraCoupling::kBetween) {
+    description_ += " (" + streams + " landmarks in the window, weighed by image quality)";
+  } else {
+    description_ += " (" + streams + " motion in the window, weighed by image quality)";
+  }
 }
 
 CameraAidedCore::~CameraAidedCore() {
@@ -66,6 +71,11 @@ void CameraAidedCore::relative_motions(const estimator::SlidingWindow& window,
                                        std::vector<estimator::RelativeMotion>& out) {
   sync();
   factors_->relative_motions(window, next, out);
+}
+
+std::uint8_t CameraAidedCore::add_factors(estimator::SlidingWindow& window) {
+  // The lane is idle: relative_motions joined it for this state.
+  return factors_->add_factors(window);
 }
 
 void CameraAidedCore::after_solve(const estimator::SlidingWindow& window) {

@@ -72,6 +72,7 @@ class CameraAidedCore final : public FusionCore,
                         std::vector<estimator::RelativeMotion>& out) override;
   void set_lidar_weak(bool weak) override;
   bool active() const override { return active_; }
+  std::uint8_t add_factors(estimator::SlidingWindow& window) override;
   void after_solve(const estimator::SlidingWindow& window) override;
 
   /// States appended from `first` on go to the front end (camera poses for the depth cloud).

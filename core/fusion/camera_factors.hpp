@@ -42,11 +42,22 @@
 #include "core/estimator/fusion_core.hpp"
 #include "core/estimator/window_aiding.hpp"
 #include "core/fusion/frame_motion.hpp"
+#include "core/fusion/visual_landmarks.hpp"
 #include "core/vision/frontend_frame.hpp"
 
 namespace posed::fusion {
 
+/// How a camera stream enters the window: frame-pair motions as between factors, or its
+/// features as landmarks with a reprojection factor per observation (visual_landmarks.hpp).
+enum class CameraCoupling : std::uint8_t {
+  kBetween,    ///< a between factor per stream and state
+  kLandmarks,  ///< landmarks only
+  kBoth,       ///< a between factor per stream and state, and landmarks
+};
+
 struct CameraFactorsConfig {
+  CameraCoupling coupling = CameraCoupling::kBetween;
+  VisualLandmarksConfig landmarks;  ///< with kLandmarks; focal_px is set from focal_px below
   /// which streams feed the estimate (visible, thermal, fused; vision::FrontendMode order)
   std::array<bool, 3> streams{};
   /// each stream's camera in base_link (see the header comment for the thermal one)
@@ -125,6 +136,7 @@ class CameraFactors final : public estimator::WindowAiding {
 
   void relative_motions(const estimator::SlidingWindow& window, const imu::ImuState& next,
                         std::vector<estimator::RelativeMotion>& out) override;
+  std::uint8_t add_factors(estimator::SlidingWindow& window) override;
   void after_solve(const estimator::SlidingWindow& window) override;
   void set_lidar_weak(bool weak) override { lidar_weak_ = weak; }
   /// A configured stream's gate is open.
@@ -132,6 +144,9 @@ class CameraFactors final : public estimator::WindowAiding {
 
   const std::array<VisualStreamFigures, 3>& figures() const { return figures_; }
   const CameraFactorsConfig& config() const { return config_; }
+  const VisualLandmarks& landmarks(vision::FrontendMode stream) const {
+    return landmarks_[static_cast<std::size_t>(stream)];
+  }
 
  private:
   struct StoredFrame {
@@ -157,6 +172,9 @@ class CameraFactors final : public estimator::WindowAiding {
   CameraFactorsConfig config_;
   std::array<Stream, 3> streams_;
   std::array<VisualStreamFigures, 3> figures_{};
+  std::array<VisualLandmarks, 3> landmarks_;    // per stream, with CameraCoupling::kLandmarks
+  std::array<std::uint64_t, 3> observed_id_{};  // per stream: the last state given a frame
+  std::array<HostTime, 3> observed_stamp_{};    // and that frame's stamp
   std::array<double, 3> residual_scale_{1.0, 1.0, 1.0};    // per stream, see residual_scaling
   std::array<std::optional<HostTime>, 3> keyframe_stamp_;  // per stream, see keyframe_states
   bool lidar_weak_ = true;         // keyframes only then (see keyframe_states)

@@ -359,9 +359,12 @@ const Field kSchema[] = {
       "a scan this far from the last keyframe is a keyframe (exported map poses)"),
     F("estimator.keyframe_angle_deg", estimator.keyframe_angle_deg, "11.5", "deg", 0.1, 180, "",
       "or turned this much"),
-    F("estimator.camera_coupling", estimator.camera_coupling, "loose", "", 0, 0, "loose|off",
+    F("estimator.camera_coupling", estimator.camera_coupling, "loose", "", 0, 0,
+      "loose|landmarks|loose+landmarks|off",
       "cameras in the estimate: each stream's frame-to-frame motion (lidar depth for scale) as a "
-      "between factor per state (seed 002), or off (the front end only reports)"),
+      "between factor per state (seed 002); landmarks, each feature with lidar depth a point fixed "
+      "where it was first seen and a reprojection factor per later state that sees it (LVI-SAM's "
+      "VIS); or off (the front end only reports)"),
     F("estimator.camera_pixel_sigma_px", estimator.camera_pixel_sigma_px, "1", "px", 0.05, 20, "",
       "feature noise of a frame-to-frame motion: its covariance at omega = 1 (Sigma_base)"),
     F("estimator.camera_quality_weighting", estimator.camera_quality_weighting, "true", "", 0, 0,
@@ -391,6 +394,16 @@ const Field kSchema[] = {
     F("estimator.camera_keyframe_states", estimator.camera_keyframe_states, "5", "", 1, 49, "",
       "a camera motion starts from a keyframe state and ends at each new state, for this many "
       "states (at most window_size - 1); 1: from the previous state only"),
+    F("estimator.camera_landmark_gate_px", estimator.camera_landmark_gate_px, "20", "px", 0.5, 1000,
+      "",
+      "with camera_coupling: landmarks, an observation further than this from where the window "
+      "projects its landmark is not added"),
+    F("estimator.camera_landmark_outlier_sigma", estimator.camera_landmark_outlier_sigma, "15", "",
+      0.5, 1000, "",
+      "and a landmark whose newest observation the solve leaves further off than this many pixel "
+      "sigmas takes no more"),
+    F("estimator.camera_landmark_huber_sigma", estimator.camera_landmark_huber_sigma, "3", "", 0.1,
+      1000, "", "Huber threshold of the landmark factors, in pixel sigmas"),
     F("estimator.camera_still_flow_sigma", estimator.camera_still_flow_sigma, "2", "", 0, 100, "",
       "a feature nearer to where it was than to where the predicted motion moves it, by more than "
       "this many pixel sigmas, is left out (a corner of the lamp's shading or lens dirt); 0: off"),

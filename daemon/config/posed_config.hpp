@@ -230,7 +230,7 @@ struct EstimatorSection {
   double map_confirm_s = 0;          ///< a map voxel is matched once scans hit it this long [s]
   double keyframe_distance_m = 1.0;  ///< keyframe spacing [m]
   double keyframe_angle_deg = 11.5;  ///< keyframe spacing [deg]
-  std::string camera_coupling = "loose";      ///< loose (between factors) | off (front end only)
+  std::string camera_coupling = "loose";      ///< loose (between factors) | landmarks | off
   double camera_pixel_sigma_px = 1.0;         ///< Σ_base of a frame-to-frame motion [px]
   bool camera_quality_weighting = true;       ///< Σ = ω Σ_base (seed 002); false: ω = 1
   bool camera_residual_scaling = true;        ///< and by their disagreement with the other stream
@@ -242,6 +242,9 @@ struct EstimatorSection {
   double camera_floor_translation_m = 0.002;  ///< 1-sigma floor per factor [m]
   double camera_floor_rotation_deg = 0.06;    ///< 1-sigma floor per factor [deg]
   int camera_keyframe_states = 5;             ///< states a keyframe anchors motions for [1]
+  double camera_landmark_gate_px = 20;        ///< observations further off are not added [px]
+  double camera_landmark_outlier_sigma = 15;  ///< landmarks the solve leaves further off go [sigma]
+  double camera_landmark_huber_sigma = 3;     ///< Huber threshold of their factors [sigma]
   double camera_still_flow_sigma = 2;         ///< features that hold still are left out [sigma]
   bool pose_selection = true;                 ///< seed 001's adaptive initial value
   double camera_degeneracy_translation_threshold = 10;  ///< with cameras in the estimate [1]

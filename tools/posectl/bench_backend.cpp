@@ -2,7 +2,9 @@
 // 1 m/s past 400 points; 15 Hz frames see them with 0.5 px of noise and lidar depth, states come
 // at 10 Hz with preintegrated IMU and lidar poses in a 10-state window (the LIO window's shape).
 // Per state: the camera back end's frame-to-frame motion (CameraFactors::relative_motions, one
-// stream) and the window solve with its camera factor, against the same solve without cameras.
+// stream) and the window solve with its camera factor, against the same solve without cameras;
+// and the same with the stream's features as landmarks (estimator.camera_coupling: landmarks):
+// their reprojection factors added (CameraFactors::add_factors) and the window solved.
 
 #include <algorithm>
 #include <chrono>
@@ -111,25 +113,33 @@ int bench_backend() {
   c.T_imu_sensor = {T_imu_cam(), T_imu_cam(), T_imu_cam()};
   c.focal_px = 617;
   fusion::CameraFactors factors(c);
+  fusion::CameraFactorsConfig lc = c;
+  lc.coupling = fusion::CameraCoupling::kLandmarks;
+  fusion::CameraFactors landmark_factors(lc);
   estimator::SlidingWindowConfig wc;
   wc.size = 10;
   wc.gravity_mps2 = kGravity;
-  estimator::SlidingWindow with(wc), without(wc);
+  estimator::SlidingWindow with(wc), without(wc), landmarks(wc);
   Eigen::Matrix<double, 15, 1> sigma = Eigen::Matrix<double, 15, 1>::Constant(0.01);
   with.reset(state_at(0), sigma);
   without.reset(state_at(0), sigma);
+  landmarks.reset(state_at(0), sigma);
   estimator::LidarPose lidar;
   lidar.information.setIdentity();
   lidar.information.topLeftCorner<3, 3>() *= 1e6;
   lidar.information.bottomRightCorner<3, 3>() *= 1e4;
-  std::vector<double> motion_ms, solve_with_ms, solve_without_ms;
+  std::vector<double> motion_ms, solve_with_ms, solve_without_ms, landmarks_ms;
+  double landmark_factors_in_window = 0;
   std::vector<estimator::RelativeMotion> motions;
   double t_frame = 0.021;
   const int states = 600;
   for (int k = 1; k <= states; ++k) {
     const double t = 0.1 * k;
-    for (; t_frame <= t; t_frame += 1.0 / 15)
-      factors.add_frame(vision::FrontendMode::kVisible, scene.frame(t_frame));
+    for (; t_frame <= t; t_frame += 1.0 / 15) {
+      const vision::FrontendFrame frame = scene.frame(t_frame);
+      factors.add_frame(vision::FrontendMode::kVisible, frame);
+      landmark_factors.add_frame(vision::FrontendMode::kVisible, frame);
+    }
     const imu::Preintegration pre = preintegrate(t - 0.1, t);
     lidar.T_map_lidar = truth(t);
     motions.clear();
@@ -155,6 +165,16 @@ int bench_backend() {
     t0 = Clock::now();
     without.solve();
     solve_without_ms.push_back(ms_since(t0));
+    motions.clear();
+    landmark_factors.relative_motions(landmarks, state_at(t), motions);  // none: landmarks only
+    landmarks.add(state_at(t), pre, lidar);
+    t0 = Clock::now();
+    landmark_factors.add_factors(landmarks);
+    landmarks.solve();
+    landmark_factors.after_solve(landmarks);
+    landmarks_ms.push_back(ms_since(t0));
+    landmark_factors_in_window += static_cast<double>(
+        landmarks.factor_counts()[static_cast<std::size_t>(estimator::FactorKind::kVisible)]);
   }
   const double factors_added = static_cast<double>(factors.figures()[0].factors);
   report("backend", "states", states, "count");
@@ -181,6 +201,11 @@ int bench_backend() {
   report("backend", "cameras_per_state_median", quantile(total, 0.5), "ms");
   report("backend", "cameras_per_state_p99", quantile(total, 0.99), "ms");
   report("backend", "cameras_per_frame_median", quantile(total, 0.5) * 10.0 / 15.0, "ms");
+  for (std::size_t i = 0; i < landmarks_ms.size(); ++i) landmarks_ms[i] -= solve_without_ms[i];
+  report("backend", "landmark_factors_in_window_mean", landmark_factors_in_window / states,
+         "count");
+  report("backend", "landmarks_per_state_median", quantile(landmarks_ms, 0.5), "ms");
+  report("backend", "landmarks_per_state_p99", quantile(landmarks_ms, 0.99), "ms");
   return factors_added > 0.9 * states ? 0 : 1;
 }
 

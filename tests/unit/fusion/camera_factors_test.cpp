@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "core/math/so3.hpp"
@@ -207,6 +208,119 @@ TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {
   EXPECT_EQ(step(1.4), 1u);
   EXPECT_EQ(factors.figures()[0].left, 1u);
   EXPECT_EQ(factors.figures()[0].rejoined, 1u);
+}
+
+CameraFactorsConfig landmark_config() {
+  CameraFactorsConfig c = factors_config();
+  c.coupling = CameraCoupling::kLandmarks;
+  return c;
+}
+
+/// Runs states every 0.1 s from 0 to `t_last` s on the truth, frames at 15 Hz off the states'
+/// stamps; each frame reaches the back end `frame_delay_states` states after the state it falls
+/// before. Returns the window's visible factors after the last state.
+std::size_t run_landmarks(CameraFactors& factors, const FactorsWorld& world, double t_last,
+                          int frame_delay_states, estimator::SlidingWindow& window) {
+  Eigen::Matrix<double, 15, 1> sigma = Eigen::Matrix<double, 15, 1>::Constant(0.01);
+  window.reset(state_at(0.0), sigma);
+  imu::Preintegration pre(imu::ImuNoise{1e-3, 1e-2, 1e-5, 1e-4}, imu::ImuBias{}, HostTime{});
+  double t_frame = 0.013;
+  std::vector<estimator::RelativeMotion> motions;
+  for (int k = 1; k * 0.1 <= t_last + 1e-9; ++k) {
+    for (; t_frame < (k - frame_delay_states) * 0.1; t_frame += 1.0 / 15) {
+      factors.add_frame(vision::FrontendMode::kVisible, world.frame(t_frame, 0.9));
+    }
+    motions.clear();
+    factors.relative_motions(window, state_at(k * 0.1), motions);
+    EXPECT_TRUE(motions.empty());  // landmarks replace the between factors
+    window.add(state_at(k * 0.1), pre, std::nullopt);
+    factors.add_factors(window);
+  }
+  return window.factor_counts()[static_cast<std::size_t>(estimator::FactorKind::kVisible)];
+}
+
+TEST(CameraFactors, LandmarksTieLaterStatesToWhereAFeatureWasFirstSeen) {
+  const FactorsWorld world;
+  CameraFactors factors(landmark_config());
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  const std::size_t in_window = run_landmarks(factors, world, 0.6, 0, window);
+  const VisualLandmarksFigures& f = factors.landmarks(vision::FrontendMode::kVisible).figures();
+  EXPECT_GT(f.anchored, 20u);
+  EXPECT_GT(in_window, 100u);
+  EXPECT_EQ(f.factors, in_window);  // nothing marginalised yet: 7 states
+  EXPECT_EQ(f.still, 0u);
+  EXPECT_EQ(f.gated, 0u);
+  // On the truth every factor is explained to a fraction of a pixel (the bridges from the frames'
+  // stamps to the states' are interpolated).
+  std::vector<double> residuals;
+  window.residual_norms(estimator::FactorKind::kVisible, residuals);
+  ASSERT_EQ(residuals.size(), in_window);
+  EXPECT_LT(*std::max_element(residuals.begin(), residuals.end()), 0.2);
+  EXPECT_EQ(factors.figures()[0].factors, in_window);
+}
+
+TEST(CameraFactors, ALandmarkFrameThatArrivesAfterItsStateIsStillThatStatesObservation) {
+  const FactorsWorld world;
+  CameraFactors in_time(landmark_config()), late(landmark_config());
+  estimator::SlidingWindow w_in_time(estimator::SlidingWindowConfig{}),
+      w_late(estimator::SlidingWindowConfig{});
+  const std::size_t n_in_time = run_landmarks(in_time, world, 0.8, 0, w_in_time);
+  // A frame comes one state late: the newest state has none yet, the one before gets its own.
+  const std::size_t n_late = run_landmarks(late, world, 0.9, 1, w_late);
+  // Late by a state, the run one state longer holds the same observations up to 0.8 s.
+  EXPECT_EQ(n_late, n_in_time);
+  std::vector<double> residuals;
+  w_late.residual_norms(estimator::FactorKind::kVisible, residuals);
+  EXPECT_LT(*std::max_element(residuals.begin(), residuals.end()), 0.2);
+}
+
+TEST(CameraFactors, ALandmarkThatHoldsStillInTheImageIsDropped) {
+  const FactorsWorld world;
+  CameraFactors factors(landmark_config());
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  Eigen::Matrix<double, 15, 1> sigma = Eigen::Matrix<double, 15, 1>::Constant(0.01);
+  window.reset(state_at(0.0), sigma);
+  imu::Preintegration pre(imu::ImuNoise{1e-3, 1e-2, 1e-5, 1e-4}, imu::ImuBias{}, HostTime{});
+  double t_frame = 0.013;
+  for (int k = 1; k <= 8; ++k) {
+    for (; t_frame < k * 0.1; t_frame += 1.0 / 15) {
+      vision::FrontendFrame frame = world.frame(t_frame, 0.9);
+      // A corner of the lamp's shading on the wall: 2 m away, always at the same pixel.
+      vision::FrontendFeature still;
+      still.id = 100000;
+      still.normalised = Eigen::Vector2d(0.3, 0.1);
+      still.depth_m = 2.0;
+      still.verified = true;
+      still.track_length = 10;
+      frame.features.push_back(still);
+      factors.add_frame(vision::FrontendMode::kVisible, frame);
+    }
+    window.add(state_at(k * 0.1), pre, std::nullopt);
+    factors.add_factors(window);
+  }
+  const VisualLandmarksFigures& f = factors.landmarks(vision::FrontendMode::kVisible).figures();
+  EXPECT_EQ(f.still, 1u);
+  std::vector<double> residuals;
+  window.residual_norms(estimator::FactorKind::kVisible, residuals);
+  EXPECT_LT(*std::max_element(residuals.begin(), residuals.end()), 0.2);  // none of it entered
+}
+
+TEST(CameraFactors, LandmarksLeaveWithTheirStreamsQualityGate) {
+  const FactorsWorld world;
+  CameraFactors factors(landmark_config());
+  estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+  run_landmarks(factors, world, 0.4, 0, window);
+  EXPECT_GT(factors.landmarks(vision::FrontendMode::kVisible).figures().tracked, 0u);
+  imu::Preintegration pre(imu::ImuNoise{1e-3, 1e-2, 1e-5, 1e-4}, imu::ImuBias{}, HostTime{});
+  for (double t = 0.413; t < 0.8; t += 1.0 / 15) {  // blinded
+    factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.01));
+  }
+  ASSERT_FALSE(factors.figures()[0].active);
+  const std::uint64_t before = factors.landmarks(vision::FrontendMode::kVisible).figures().factors;
+  window.add(state_at(0.5), pre, std::nullopt);
+  EXPECT_EQ(factors.add_factors(window), 0);
+  EXPECT_EQ(factors.landmarks(vision::FrontendMode::kVisible).figures().factors, before);
+  EXPECT_EQ(factors.landmarks(vision::FrontendMode::kVisible).tracked(), 0u);
 }
 
 }  // namespace
