@@ -489,6 +489,11 @@ const Field kSchema[] = {
       "a track is kept when KLT, run back from the new frame, lands within this of where it "
       "started (docs/estimator.md: 1 px tracked 65 % of the simulated corridor's features per "
       "frame instead of 54 %, with better frame-pair motions, but did not make every run better)"),
+    F("frontend.klt_window_px", frontend.klt_window_px, "15", "px", 5, 61, "",
+      "side of the KLT window (VINS-Mono 21, OpenVINS 15): larger follows faster flow and blurs "
+      "depth edges, and costs the square"),
+    F("frontend.klt_pyramid_levels", frontend.klt_pyramid_levels, "3", "", 0, 6, "",
+      "KLT pyramid levels above the image: each doubles the flow it can follow"),
     F("frontend.lines", frontend.lines, "false", "", 0, 0, "",
       "also track LSD line features (seed 001); several ms per frame"),
     F("frontend.depth_window_s", frontend.depth_window_s, "1", "s", 0, 10, "",

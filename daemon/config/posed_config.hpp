@@ -201,6 +201,8 @@ struct FrontendSection {
   double min_feature_distance_px = 20;  ///< [px]
   double ransac_threshold_px = 4;       ///< [px]
   double forward_backward_px = 0.5;     ///< KLT round-trip error allowed [px]
+  int klt_window_px = 15;               ///< KLT window side [px]
+  int klt_pyramid_levels = 3;           ///< KLT pyramid levels above the image [1]
   bool lines = false;
   double depth_window_s = 1;  ///< [s]
   int depth_points_per_scan = 20000;

@@ -90,6 +90,8 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   f.tracker.min_distance_px = s.min_feature_distance_px;
   f.tracker.ransac_threshold_px = s.ransac_threshold_px;
   f.tracker.max_forward_backward_px = s.forward_backward_px;
+  f.tracker.klt_window_px = s.klt_window_px;
+  f.tracker.klt_pyramid_levels = s.klt_pyramid_levels;
   f.tracker.corner_noise_factor = s.corner_noise_factor;
   f.lines = s.lines;
   f.depth.max_span_m = s.depth_max_span_m;

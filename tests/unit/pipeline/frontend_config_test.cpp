@@ -33,5 +33,44 @@ TEST(FrontendConfig, TheForwardBackwardDefaultIsTheTrackersOwn) {
                    vision::TrackerConfig{}.max_forward_backward_px);
 }
 
+TEST(FrontendConfig, TheKltWindowAndPyramidAreTheConfiguredOnesAndDefaultToTheTrackers) {
+  const fusion::CameraFrontEndConfig c =
+      front_end_of("frontend:\n  klt_window_px: 21\n  klt_pyramid_levels: 4\n");
+  EXPECT_EQ(c.frontend.tracker.klt_window_px, 21);
+  EXPECT_EQ(c.frontend.tracker.klt_pyramid_levels, 4);
+  const fusion::CameraFrontEndConfig d = front_end_of("");
+  EXPECT_EQ(d.frontend.tracker.klt_window_px, vision::TrackerConfig{}.klt_window_px);
+  EXPECT_EQ(d.frontend.tracker.klt_pyramid_levels, vision::TrackerConfig{}.klt_pyramid_levels);
+}
+
+fusion::CameraFactorsConfig factors_of(const std::string& yaml) {
+  const config::LoadResult loaded = config::load_config_text(yaml, "test.yaml");
+  EXPECT_TRUE(loaded.ok()) << loaded.error_text();
+  std::string note;
+  const fusion::CameraFrontEndConfig cameras =
+      camera_front_end_config(loaded.config, true, true, true, note);
+  return camera_factors_config(loaded.config, cameras);
+}
+
+TEST(FrontendConfig, TheCameraCouplingAndTheLandmarksThresholdsAreTheConfiguredOnes) {
+  EXPECT_EQ(factors_of("").coupling, fusion::CameraCoupling::kBetween);
+  const fusion::CameraFactorsConfig l = factors_of(
+      "estimator:\n  camera_coupling: landmarks\n  camera_landmark_huber_sigma: 2.5\n"
+      "  camera_landmark_gate_px: 12\n  camera_landmark_outlier_sigma: 8\n");
+  EXPECT_EQ(l.coupling, fusion::CameraCoupling::kLandmarks);
+  EXPECT_TRUE(l.streams[0]);
+  EXPECT_DOUBLE_EQ(l.landmarks.huber_sigma, 2.5);
+  EXPECT_DOUBLE_EQ(l.landmarks.gate_px, 12);
+  EXPECT_DOUBLE_EQ(l.landmarks.outlier_sigma, 8);
+  EXPECT_EQ(factors_of("estimator:\n  camera_coupling: loose+landmarks\n").coupling,
+            fusion::CameraCoupling::kBoth);
+  // A coupling the schema does not know stops start-up, naming the key.
+  const config::LoadResult bad =
+      config::load_config_text("estimator:\n  camera_coupling: tight\n", "test.yaml");
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.error_text().find("estimator.camera_coupling"), std::string::npos)
+      << bad.error_text();
+}
+
 }  // namespace
 }  // namespace posed::pipeline
