@@ -18,13 +18,6 @@ constexpr estimator::FactorKind kKinds[3] = {estimator::FactorKind::kVisible,
 /// Frames kept per stream: more than a window of states needs at 15-25 Hz.
 constexpr std::size_t kFramesKept = 48;
 
-Eigen::Isometry3d isometry(const imu::ImuState& s) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = s.q_map_imu.normalized().toRotationMatrix();
-  T.translation() = s.p_map_imu_m;
-  return T;
-}
-
 Pose pose(const imu::ImuState& s) { return Pose{s.stamp, s.p_map_imu_m, s.q_map_imu}; }
 
 Eigen::Isometry3d isometry(const Pose& p) {
@@ -170,12 +163,12 @@ std::optional<estimator::RelativeMotion> CameraFactors::measure(
   f.reprojection_rms_px = m.rms_sigma * config_.pixel_sigma_px;
   // T_k_j = (T_k⁻¹ T_a) M (T_b⁻¹ T_j); the measurement's perturbation moves through the
   // extrinsic and the bridge to state j (right perturbations: Ad of the inverse bridge).
-  const Eigen::Isometry3d bridge_b_j = T_map_b.inverse() * isometry(next);
+  const Eigen::Isometry3d bridge_b_j = T_map_b.inverse() * imu::T_map_imu(next);
   estimator::RelativeMotion motion;
   motion.kind = kKinds[stream];
   motion.from_index = k;
-  motion.T_k_j = isometry(at_k).inverse() * T_map_a * measured_a_b * bridge_b_j;
-  motion.T_i_j = isometry(i).inverse() * isometry(at_k) * motion.T_k_j;
+  motion.T_k_j = imu::T_map_imu(at_k).inverse() * T_map_a * measured_a_b * bridge_b_j;
+  motion.T_i_j = imu::T_map_imu(i).inverse() * imu::T_map_imu(at_k) * motion.T_k_j;
   const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
   const double omega = std::max(a->omega, b->omega) * residual_scale_[stream];
   Mat6 covariance = omega * A * m.covariance * A.transpose();
@@ -279,7 +272,7 @@ std::uint8_t CameraFactors::add_factors(estimator::SlidingWindow& window) {
       const std::optional<Pose> at_frame = interpolate_pose(pose(before), pose(at), frame->stamp);
       if (!at_frame) continue;
       const Eigen::Isometry3d T_body_cam =
-          isometry(at).inverse() * isometry(*at_frame) * config_.T_imu_sensor[stream];
+          imu::T_map_imu(at).inverse() * isometry(*at_frame) * config_.T_imu_sensor[stream];
       const double omega = frame->omega * residual_scale_[stream];
       const double sqrt_information =
           config_.focal_px / (config_.pixel_sigma_px * std::sqrt(omega));

@@ -7,23 +7,12 @@
 #include "core/estimator/factors.hpp"
 
 namespace posed::fusion {
-namespace {
-
-Eigen::Isometry3d isometry(const imu::ImuState& s) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = s.q_map_imu.normalized().toRotationMatrix();
-  T.translation() = s.p_map_imu_m;
-  return T;
-}
-
-}  // namespace
-
 int VisualLandmarks::add(estimator::SlidingWindow& window, std::size_t observer,
                          estimator::FactorKind kind, const std::vector<FrameFeature>& features,
                          const Eigen::Isometry3d& T_body_cam, double sqrt_information) {
   using estimator::BlockRole;
   const std::uint64_t observer_id = window.id(observer);
-  const Eigen::Isometry3d T_map_j = isometry(window.state(observer));
+  const Eigen::Isometry3d T_map_j = imu::T_map_imu(window.state(observer));
   // Landmarks whose anchor has left the window go: their factors were marginalised with it.
   std::erase_if(landmarks_, [&](const auto& entry) {
     return !window.index_of(entry.second.anchor_id).has_value();
@@ -52,7 +41,7 @@ int VisualLandmarks::add(estimator::SlidingWindow& window, std::size_t observer,
     if (!a) continue;
     auto factor = std::make_unique<estimator::LandmarkFactor>(l.X_anchor, T_body_cam, f.normalised,
                                                               sqrt_information);
-    const Eigen::Vector3d P_c = factor->point_in_camera(isometry(window.state(*a)), T_map_j);
+    const Eigen::Vector3d P_c = factor->point_in_camera(imu::T_map_imu(window.state(*a)), T_map_j);
     if (P_c.z() <= config_.min_depth_m) {
       ++figures_.gated;
       continue;
@@ -91,14 +80,14 @@ int VisualLandmarks::add(estimator::SlidingWindow& window, std::size_t observer,
 void VisualLandmarks::after_solve(const estimator::SlidingWindow& window) {
   const std::optional<std::size_t> j = window.index_of(last_observer_id_);
   if (!j) return;
-  const Eigen::Isometry3d T_map_j = isometry(window.state(*j));
+  const Eigen::Isometry3d T_map_j = imu::T_map_imu(window.state(*j));
   for (auto& [id, l] : landmarks_) {
     if (l.outlier || l.last_id != last_observer_id_) continue;
     const std::optional<std::size_t> a = window.index_of(l.anchor_id);
     if (!a) continue;
     const estimator::LandmarkFactor factor(l.X_anchor, l.T_body_cam_last, l.observed_last,
                                            l.sqrt_information_last);
-    const Eigen::Vector3d P_c = factor.point_in_camera(isometry(window.state(*a)), T_map_j);
+    const Eigen::Vector3d P_c = factor.point_in_camera(imu::T_map_imu(window.state(*a)), T_map_j);
     const double whitened =
         P_c.z() > 0 ? (P_c.head<2>() / P_c.z() - l.observed_last).norm() * l.sqrt_information_last
                     : 1e9;

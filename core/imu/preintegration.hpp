@@ -46,6 +46,14 @@ struct ImuState {
   ImuBias bias;
 };
 
+/// The state's pose as a transform, T_map_imu (its quaternion normalised).
+inline Eigen::Isometry3d T_map_imu(const ImuState& s) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = s.q_map_imu.normalized().toRotationMatrix();
+  T.translation() = s.p_map_imu_m;
+  return T;
+}
+
 class Preintegration {
  public:
   /// Starts empty at `stamp`, integrating with the biases `bias` (the linearisation point).

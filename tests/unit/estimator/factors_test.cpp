@@ -167,14 +167,14 @@ TEST(Factors, LandmarkFactorIsZeroWhereThePointProjectsOntoItsObservation) {
   const Eigen::Vector3d P_c = (T_map_j * T_body_cam).inverse() * (T_map_a * X_a);
   const LandmarkFactor factor(X_a, T_body_cam, P_c.head<2>() / P_c.z(), 600.0);
   EXPECT_LT((factor.point_in_camera(T_map_a, T_map_j) - P_c).norm(), 1e-12);
-  double pose_a[7], pose_j[7], r[2];
-  for (int k = 0; k < 3; ++k) {
-    pose_a[k] = T_map_a.translation()[k];
-    pose_j[k] = T_map_j.translation()[k];
-  }
-  const Eigen::Quaterniond qa(T_map_a.linear()), qj(T_map_j.linear());
-  std::copy_n(qa.coeffs().data(), 4, pose_a + 3);
-  std::copy_n(qj.coeffs().data(), 4, pose_j + 3);
+  imu::ImuState a, j;
+  a.q_map_imu = Eigen::Quaterniond(T_map_a.linear());
+  a.p_map_imu_m = T_map_a.translation();
+  j.q_map_imu = Eigen::Quaterniond(T_map_j.linear());
+  j.p_map_imu_m = T_map_j.translation();
+  double pose_a[7], pose_j[7], sb[9], r[2];
+  state_arrays(a, pose_a, sb);
+  state_arrays(j, pose_j, sb);
   const double* params[] = {pose_a, pose_j};
   ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
   EXPECT_NEAR(r[0], 0.0, 1e-9);

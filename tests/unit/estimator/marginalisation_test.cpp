@@ -26,6 +26,26 @@ Eigen::Isometry3d marg_pose_of(const imu::ImuState& s) {
   return T;
 }
 
+/// The IMU's samples over the step ending at `t`, with white noise at `noise_density`,
+/// preintegrated from `prev`.
+imu::Preintegration noisy_preintegration(const test::AnalyticMotion& m,
+                                         const imu::ImuNoise& noise_density,
+                                         const imu::ImuState& prev, double t, std::mt19937& rng,
+                                         std::normal_distribution<double>& n01) {
+  imu::Preintegration pre(noise_density, prev.bias, prev.stamp);
+  for (int i = 0; i <= static_cast<int>(std::lround(kMargStep * kMargImuHz)); ++i) {
+    ImuSample s = m.sample(t - kMargStep + i / kMargImuHz);
+    for (int a = 0; a < 3; ++a) {
+      s.angular_velocity_radps[a] +=
+          noise_density.gyro_noise_density * std::sqrt(kMargImuHz) * n01(rng);
+      s.specific_force_mps2[a] +=
+          noise_density.accel_noise_density * std::sqrt(kMargImuHz) * n01(rng);
+    }
+    pre.add(s);
+  }
+  return pre;
+}
+
 /// The last state of a window of `size` run over `states` steps of the same noisy data.
 imu::ImuState run_window(int size, int steps) {
   const test::AnalyticMotion m;
@@ -49,17 +69,7 @@ imu::ImuState run_window(int size, int steps) {
   for (int k = 1; k <= steps; ++k) {
     const double t = k * kMargStep;
     const imu::ImuState prev = w.latest();
-    imu::Preintegration pre(noise_density, prev.bias, prev.stamp);
-    for (int i = 0; i <= static_cast<int>(std::lround(kMargStep * kMargImuHz)); ++i) {
-      ImuSample s = m.sample(t - kMargStep + i / kMargImuHz);
-      for (int a = 0; a < 3; ++a) {
-        s.angular_velocity_radps[a] +=
-            noise_density.gyro_noise_density * std::sqrt(kMargImuHz) * n01(rng);
-        s.specific_force_mps2[a] +=
-            noise_density.accel_noise_density * std::sqrt(kMargImuHz) * n01(rng);
-      }
-      pre.add(s);
-    }
+    const imu::Preintegration pre = noisy_preintegration(m, noise_density, prev, t, rng, n01);
     imu::ImuState guess = pre.predict(prev, m.gravity_mps2);
     guess.stamp = m.state(t).stamp;
     // The camera's motion since the previous state, with noise.
@@ -124,17 +134,7 @@ imu::ImuState run_landmark_window(int size, int steps) {
   for (int k = 1; k <= steps; ++k) {
     const double t = k * kMargStep;
     const imu::ImuState prev = w.latest();
-    imu::Preintegration pre(noise_density, prev.bias, prev.stamp);
-    for (int i = 0; i <= static_cast<int>(std::lround(kMargStep * kMargImuHz)); ++i) {
-      ImuSample s = m.sample(t - kMargStep + i / kMargImuHz);
-      for (int a = 0; a < 3; ++a) {
-        s.angular_velocity_radps[a] +=
-            noise_density.gyro_noise_density * std::sqrt(kMargImuHz) * n01(rng);
-        s.specific_force_mps2[a] +=
-            noise_density.accel_noise_density * std::sqrt(kMargImuHz) * n01(rng);
-      }
-      pre.add(s);
-    }
+    const imu::Preintegration pre = noisy_preintegration(m, noise_density, prev, t, rng, n01);
     imu::ImuState guess = pre.predict(prev, m.gravity_mps2);
     guess.stamp = m.state(t).stamp;
     w.add(guess, pre, std::nullopt);
