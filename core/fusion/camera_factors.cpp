@@ -58,7 +58,6 @@ CameraFactors::CameraFactors(const CameraFactorsConfig& config)
   config_.motion.pixel_sigma = config.pixel_sigma_px / config.focal_px;
   config_.motion.fix_rotation = config.translation_only;
   config_.motion.min_inliers = config.min_observations;
-  config_.motion.guess_gate = config.guess_gate_px / config.focal_px;
   for (std::size_t i = 0; i < 3; ++i) {
     figures_[i].configured = config.streams[i];
     figures_[i].active = config.streams[i];
@@ -145,6 +144,8 @@ std::optional<estimator::RelativeMotion> CameraFactors::measure(
   const Eigen::Isometry3d predicted_a_b = T_map_a.inverse() * T_map_b;  // base_link, a to b
   FrameMotionConfig motion_config = config_.motion;
   motion_config.gate_falls_back = stream == 0 || !config_.thermal_gate_strict;  // 0: visible
+  motion_config.guess_gate =
+      (lidar_weak_ ? config_.weak_lidar_guess_gate_px : config_.guess_gate_px) / config_.focal_px;
   const FrameMotion m = estimate_frame_motion(
       a->features, b->features, T_imu_s.inverse() * predicted_a_b * T_imu_s, motion_config);
   if (!m.ok()) {

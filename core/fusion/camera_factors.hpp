@@ -81,6 +81,11 @@ struct CameraFactorsConfig {
   /// features further than this from where the window's prediction puts them are left out of a
   /// frame pair's motion (frame_motion.hpp's guess_gate) [px]
   double guess_gate_px = 3.0;
+  /// the same gate where the lidar has recently been weak (set_lidar_weak): there the window's
+  /// speed along the lidar's blind direction is only as good as the cameras made it, and a guess
+  /// a quarter off moves a near feature's prediction by more than 3 px; what is left inside a
+  /// tight gate are the distant features, which agree with any speed and confirm the guess [px]
+  double weak_lidar_guess_gate_px = 6.0;
   /// the thermal and fused streams' gates never fall back to all observations
   /// (FrameMotionConfig::gate_falls_back): their fixed pattern can be the majority
   bool thermal_gate_strict = true;

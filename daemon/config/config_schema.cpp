@@ -404,6 +404,13 @@ const Field kSchema[] = {
       "sigmas takes no more"),
     F("estimator.camera_landmark_huber_sigma", estimator.camera_landmark_huber_sigma, "3", "", 0.1,
       1000, "", "Huber threshold of the landmark factors, in pixel sigmas"),
+    F("estimator.camera_guess_gate_px", estimator.camera_guess_gate_px, "3", "px", 0, 1000, "",
+      "a tracked feature further than this from where the window's predicted motion puts it is "
+      "left out of its frame pair's motion (unless that leaves fewer than half); 0: no gate"),
+    F("estimator.camera_weak_lidar_guess_gate_px", estimator.camera_weak_lidar_guess_gate_px, "6",
+      "px", 0, 1000, "",
+      "the same gate within camera_lidar_suspect_window_s of a degenerate scan, where the "
+      "predicted speed along the lidar's blind direction can be a quarter off"),
     F("estimator.camera_still_flow_sigma", estimator.camera_still_flow_sigma, "2", "", 0, 100, "",
       "a feature nearer to where it was than to where the predicted motion moves it, by more than "
       "this many pixel sigmas, is left out (a corner of the lamp's shading or lens dirt); 0: off"),

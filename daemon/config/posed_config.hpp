@@ -248,7 +248,9 @@ struct EstimatorSection {
   double camera_landmark_outlier_sigma = 15;  ///< landmarks the solve leaves further off go [sigma]
   double camera_landmark_huber_sigma = 3;     ///< Huber threshold of their factors [sigma]
   double camera_still_flow_sigma = 2;         ///< features that hold still are left out [sigma]
-  bool pose_selection = true;                 ///< seed 001's adaptive initial value
+  double camera_guess_gate_px = 3;            ///< features further from the prediction: out [px]
+  double camera_weak_lidar_guess_gate_px = 6;           ///< the same near a degenerate scan [px]
+  bool pose_selection = true;                           ///< seed 001's adaptive initial value
   double camera_degeneracy_translation_threshold = 10;  ///< with cameras in the estimate [1]
   double camera_degenerate_information_scale = 0;       ///< with cameras in the estimate [-]
   double camera_lidar_trusted_constraints = 200;  ///< above: a scan's direction is not checked [1]

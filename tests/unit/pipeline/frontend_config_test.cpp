@@ -62,6 +62,13 @@ TEST(FrontendConfig, TheCameraCouplingAndTheLandmarksThresholdsAreTheConfiguredO
   EXPECT_DOUBLE_EQ(l.landmarks.huber_sigma, 2.5);
   EXPECT_DOUBLE_EQ(l.landmarks.gate_px, 12);
   EXPECT_DOUBLE_EQ(l.landmarks.outlier_sigma, 8);
+  // The frame pairs' gates about the prediction: 3 px, and 6 px where the lidar is weak.
+  EXPECT_DOUBLE_EQ(factors_of("").guess_gate_px, 3);
+  EXPECT_DOUBLE_EQ(factors_of("").weak_lidar_guess_gate_px, 6);
+  const fusion::CameraFactorsConfig g =
+      factors_of("estimator:\n  camera_guess_gate_px: 2.5\n  camera_weak_lidar_guess_gate_px: 9\n");
+  EXPECT_DOUBLE_EQ(g.guess_gate_px, 2.5);
+  EXPECT_DOUBLE_EQ(g.weak_lidar_guess_gate_px, 9);
   EXPECT_EQ(factors_of("estimator:\n  camera_coupling: loose+landmarks\n").coupling,
             fusion::CameraCoupling::kBoth);
   // A coupling the schema does not know stops start-up, naming the key.
