@@ -108,6 +108,14 @@ class Loader {
       const std::string key = prefix.empty() ? key_node.Scalar() : prefix + "." + key_node.Scalar();
       if (const Field* field = find_field(key)) {
         const YAML::Mark mark = key_node.Mark();
+        // yaml-cpp keeps both of a key written twice (in one mapping, or in a section written
+        // twice); which one counts would be an accident of order, and an edit to one of them
+        // would silently do nothing.
+        if (const auto first = places_.find(key); first != places_.end()) {
+          error(key_node, key,
+                "set twice (first on line " + std::to_string(first->second.first) + "); keep one");
+          continue;
+        }
         places_[key] = {mark.line + 1, mark.column + 1};
         apply(*field, value);
       } else if (value.IsMap() && is_section(key)) {

@@ -82,6 +82,14 @@ TEST(Config, UnknownKeyNamesLineAndSuggests) {
   expect_single_error(r, "imu.rate_hzz", 3, "unknown key (did you mean 'imu.rate_hz'?)");
 }
 
+TEST(Config, AKeySetTwiceNamesBothLines) {
+  // In one mapping, and in a section written twice: either way only one of them could count.
+  expect_single_error(load("imu:\n  rate_hz: 400\n  source: synthetic\n  rate_hz: 200\n"),
+                      "imu.rate_hz", 4, "set twice (first on line 2); keep one");
+  expect_single_error(load("imu:\n  rate_hz: 400\ndds:\n  domain_id: 7\nimu:\n  rate_hz: 200\n"),
+                      "imu.rate_hz", 6, "set twice (first on line 2); keep one");
+}
+
 TEST(Config, UnknownSection) {
   const auto r = load("camera:\n  fx: 1\n");
   expect_single_error(r, "camera", 1, "unknown key");
