@@ -29,6 +29,14 @@ void state_arrays(const imu::ImuState& s, double* pose, double* sb) {
   pose[6] = q.w();
 }
 
+/// A state at the pose T_map_imu, at rest with zero biases.
+imu::ImuState state_at_pose(const Eigen::Isometry3d& T_map_imu) {
+  imu::ImuState s;
+  s.q_map_imu = Eigen::Quaterniond(T_map_imu.linear());
+  s.p_map_imu_m = T_map_imu.translation();
+  return s;
+}
+
 /// Every Jacobian entry (in the tangent spaces) agrees with numeric differentiation to `tol`
 /// relative to its size (absolute below 1): GradientChecker's own verdict flags two zeros that
 /// differ by rounding.
@@ -167,11 +175,7 @@ TEST(Factors, LandmarkFactorIsZeroWhereThePointProjectsOntoItsObservation) {
   const Eigen::Vector3d P_c = (T_map_j * T_body_cam).inverse() * (T_map_a * X_a);
   const LandmarkFactor factor(X_a, T_body_cam, P_c.head<2>() / P_c.z(), 600.0);
   EXPECT_LT((factor.point_in_camera(T_map_a, T_map_j) - P_c).norm(), 1e-12);
-  imu::ImuState a, j;
-  a.q_map_imu = Eigen::Quaterniond(T_map_a.linear());
-  a.p_map_imu_m = T_map_a.translation();
-  j.q_map_imu = Eigen::Quaterniond(T_map_j.linear());
-  j.p_map_imu_m = T_map_j.translation();
+  const imu::ImuState a = state_at_pose(T_map_a), j = state_at_pose(T_map_j);
   double pose_a[7], pose_j[7], sb[9], r[2];
   state_arrays(a, pose_a, sb);
   state_arrays(j, pose_j, sb);
@@ -193,11 +197,8 @@ TEST(Factors, RelativePoseFactorIsZeroAtTheMeasuredMotion) {
   T_ij.translation() = Eigen::Vector3d(0.1, 0.01, 0.0);
   const Eigen::Isometry3d T_j = T_i * T_ij;
   const RelativePoseFactor factor(T_ij, Eigen::Matrix<double, 6, 6>::Identity() * 1e4);
-  imu::ImuState i, j;
-  i.q_map_imu = Eigen::Quaterniond(T_i.linear());
-  i.p_map_imu_m = T_i.translation();
-  j.q_map_imu = Eigen::Quaterniond(T_j.linear());
-  j.p_map_imu_m = T_j.translation();
+  const imu::ImuState i = state_at_pose(T_i);
+  imu::ImuState j = state_at_pose(T_j);
   double pose_i[7], pose_j[7], sb[9], r[6];
   state_arrays(i, pose_i, sb);
   state_arrays(j, pose_j, sb);
