@@ -112,10 +112,19 @@ struct Image {
 enum class CameraStream : std::uint8_t {
   kVisible,  ///< the D435i colour camera
   kThermal,  ///< the PLUG 617 thermal camera
+  kDepth,    ///< the D435i's depth node (Z16 of its left IR imager): depth for camera features
 };
 
 constexpr std::string_view to_string(CameraStream s) {
-  return s == CameraStream::kVisible ? "visible" : "thermal";
+  switch (s) {
+    case CameraStream::kVisible:
+      return "visible";
+    case CameraStream::kThermal:
+      return "thermal";
+    case CameraStream::kDepth:
+      return "depth";
+  }
+  return "unknown";
 }
 
 }  // namespace posed

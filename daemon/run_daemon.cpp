@@ -179,7 +179,7 @@ void log_pass(std::uint64_t pass, const pipeline::Pipeline& pipe, const PoseSink
   char depth[64] = "";
   if (f.camera.features_total > 0) {
     std::snprintf(depth, sizeof depth, ", lidar depth for %.1f %% of features",
-                  100.0 * static_cast<double>(f.camera.depth_total) /
+                  100.0 * static_cast<double>(f.camera.depth_total - f.camera.stereo_depth_total) /
                       static_cast<double>(f.camera.features_total));
   }
   POSED_LOG_INFO("--loop pass %llu: %s, accel bias %.3f m/s^2, %llu re-initialisations%s",
@@ -249,7 +249,9 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
   std::vector<const drivers::recording::McapReplaySource*> replayers;
   std::shared_ptr<drivers::recording::McapChunkCache> replay_chunks;
   if (replaying) {
-    pipeline::ReplaySources replay = pipeline::make_replay_sources(options.replay, error);
+    pipeline::ReplayOptions replay_options = options.replay;
+    replay_options.depth = config.depth_camera.feature_depth;
+    pipeline::ReplaySources replay = pipeline::make_replay_sources(replay_options, error);
     // Replayed stamps are the recording's host clock; its wall offset keeps the DDS stamps (and
     // so the ground truth of a simulated run) in the recorded time base.
     // With --live-stamps the stamps are this host's clock now, and so is the wall offset.
@@ -460,6 +462,7 @@ int run_daemon(const config::PosedConfig& configured, const RunOptions& options)
     }
     pass_shift = pass_shift + *next_shift;
     pipeline::ReplayOptions next = options.replay;
+    next.depth = config.depth_camera.feature_depth;
     next.time_shift = pass_shift;
     pipeline::ReplaySources replay = pipeline::make_replay_sources(next, error);
     if (!replay.built.sources.imu) {

@@ -201,18 +201,27 @@ bool print_run_summary(const RunSummary& r) {
   if (!st.estimator.camera.mode.empty()) {
     const CameraFigures& c = st.estimator.camera;
     const double frames = static_cast<double>(std::max<std::uint64_t>(c.frames, 1));
+    const auto percent = [](std::uint64_t part, std::uint64_t whole) {
+      return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+    };
+    // The D435i's depth node, where a recording or the rig has one.
+    char stereo[128] = "";
+    if (c.depth_images > 0) {
+      std::snprintf(stereo, sizeof stereo,
+                    ", depth-image depth for %.1f %% more (%llu frames given a depth image)",
+                    percent(c.stereo_depth_total, c.features_total),
+                    static_cast<unsigned long long>(c.depth_images));
+    }
     std::printf(
         "  camera front end    %s: %llu frames (%llu unusable, %llu without IMU), %.0f "
-        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features, %llu tracks "
-        "dropped as fixed to the camera, %llu frozen thermal frames left out; mean confidence "
-        "visible %.2f, thermal %.2f, fused %.2f\n",
+        "features/frame, match success %.1f %%, lidar depth for %.1f %% of features%s, %llu "
+        "tracks dropped as fixed to the camera, %llu frozen thermal frames left out; mean "
+        "confidence visible %.2f, thermal %.2f, fused %.2f\n",
         std::string(c.mode).c_str(), static_cast<unsigned long long>(c.frames),
         static_cast<unsigned long long>(c.frames_unusable),
         static_cast<unsigned long long>(c.frames_without_imu),
         static_cast<double>(c.features_total) / frames, 100.0 * c.match_success_rate(),
-        c.features_total > 0
-            ? 100.0 * static_cast<double>(c.depth_total) / static_cast<double>(c.features_total)
-            : 0.0,
+        percent(c.depth_total - c.stereo_depth_total, c.features_total), stereo,
         static_cast<unsigned long long>(c.static_dropped_total),
         static_cast<unsigned long long>(c.thermal_frozen), c.mean_confidence[0],
         c.mean_confidence[1], c.mean_confidence[2]);

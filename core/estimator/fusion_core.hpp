@@ -42,7 +42,11 @@ struct CameraFigures {
   std::uint64_t inliers_total = 0;       ///< of those, tracked and RANSAC inliers, summed [1]
   std::uint64_t extracted_total = 0;     ///< new features detected, summed [1]
   std::uint64_t features_total = 0;      ///< features output, summed [1]
-  std::uint64_t depth_total = 0;         ///< of those, with lidar depth, summed [1]
+  std::uint64_t depth_total = 0;         ///< of those, with a depth, summed [1]
+  /// of those, with the D435i depth image's (where the lidar gave none), summed [1]
+  std::uint64_t stereo_depth_total = 0;
+  /// frame events given the points of a D435i depth image (the one nearest their stamp) [1]
+  std::uint64_t depth_images = 0;
   /// thermal frames identical to the one before (shutter closed for the flat-field correction),
   /// left out [1]
   std::uint64_t thermal_frozen = 0;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 
 #include "core/fusion/gyro_rotation.hpp"
 
@@ -66,6 +68,15 @@ void CameraFrontEnd::add_scan(const MatchedScan& scan) {
 }
 
 void CameraFrontEnd::add_image(CameraStream stream, Image image) {
+  if (stream == CameraStream::kDepth) {
+    if (!config_.depth_image.enabled || image.format != PixelFormat::kDepth16) return;
+    // Frame events trail the depth images by the IMU's cover of their stamps (a few samples);
+    // a few images span that, and each holds a pool buffer of the depth camera stage.
+    constexpr std::size_t kDepthImagesHeld = 3;
+    depth_images_.push_back(std::move(image));
+    while (depth_images_.size() > kDepthImagesHeld) depth_images_.pop_front();
+    return;
+  }
   if (stream == CameraStream::kVisible) {
     pairer_.push_visible(std::move(image));
   } else {
@@ -148,27 +159,36 @@ void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps)
   // Depth: the stacked lidar points in the camera frame at the tracked image's stamp, when the
   // estimator has a pose there (none before it is aligned, or without a lidar).
   p_cam_m_.clear();
-  if (depth_.scans() > 0) {
-    if (const std::optional<Pose> T = poses_.at(e.stamp)) {
-      const Eigen::Isometry3d T_map_base = Eigen::Translation3d(T->p) * T->q.normalized();
-      depth_.points_in_camera(e.stamp, T_map_base * config_.T_imu_cam, p_cam_m_);
+  p_depth_cam_m_.clear();
+  if (const std::optional<Pose> T = poses_.at(e.stamp)) {
+    const Eigen::Isometry3d T_map_cam =
+        Eigen::Translation3d(T->p) * T->q.normalized() * config_.T_imu_cam;
+    if (depth_.scans() > 0) depth_.points_in_camera(e.stamp, T_map_cam, p_cam_m_);
+    if (!depth_images_.empty() && depth_image_points(e.stamp, T_map_cam)) {
+      for (Run& run : runs_) ++run.figures.depth_images;
     }
   }
   // Thermal mode tracks the thermal image registered at infinity: a camera at the thermal
   // camera's origin with the visible camera's axes, so its features' depth comes from the points
   // seen from there (17 cm to the side on the M2DGR rig: 3 deg of parallax at 3 m).
   p_thermal_origin_m_.clear();
+  p_depth_thermal_origin_m_.clear();
   const Eigen::Vector3f t_cam_thermal = config_.frontend.T_cam_thermal.translation().cast<float>();
   for (const Run& run : runs_) {
     if (run.frontend->config().mode != vision::FrontendMode::kThermal) continue;
     for (const Eigen::Vector3f& p : p_cam_m_) p_thermal_origin_m_.push_back(p - t_cam_thermal);
+    for (const Eigen::Vector3f& p : p_depth_cam_m_) {
+      p_depth_thermal_origin_m_.push_back(p - t_cam_thermal);
+    }
     break;
   }
   for (Run& run : runs_) {
     const vision::FrontendMode mode = run.frontend->config().mode;
-    input.p_cam_m = mode == vision::FrontendMode::kThermal
-                        ? std::span<const Eigen::Vector3f>(p_thermal_origin_m_)
-                        : std::span<const Eigen::Vector3f>(p_cam_m_);
+    const bool thermal = mode == vision::FrontendMode::kThermal;
+    input.p_cam_m = thermal ? std::span<const Eigen::Vector3f>(p_thermal_origin_m_)
+                            : std::span<const Eigen::Vector3f>(p_cam_m_);
+    input.p_depth_cam_m = thermal ? std::span<const Eigen::Vector3f>(p_depth_thermal_origin_m_)
+                                  : std::span<const Eigen::Vector3f>(p_depth_cam_m_);
     const bool usable = (mode != vision::FrontendMode::kVisible || e.visible) &&
                         (mode != vision::FrontendMode::kThermal || e.thermal) &&
                         (mode != vision::FrontendMode::kFused || (e.visible && e.thermal));
@@ -191,6 +211,47 @@ void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps)
   }
 }
 
+bool CameraFrontEnd::depth_image_points(HostTime stamp, const Eigen::Isometry3d& T_map_cam) {
+  const DepthImageConfig& c = config_.depth_image;
+  const Image* nearest = nullptr;
+  for (const Image& image : depth_images_) {
+    if (nearest == nullptr ||
+        std::abs((image.stamp - stamp).ns) < std::abs((nearest->stamp - stamp).ns)) {
+      nearest = &image;
+    }
+  }
+  if (nearest == nullptr || std::abs((nearest->stamp - stamp).ns) > c.max_offset.ns) return false;
+  // The depth image's camera at its own stamp, seen from the camera at the frame's: the robot
+  // moves up to half a depth frame period between them (2-3 cm at walking speed).
+  const std::optional<Pose> T_depth_stamp = poses_.at(nearest->stamp);
+  if (!T_depth_stamp) return false;
+  const Eigen::Isometry3d T_map_depth = Eigen::Translation3d(T_depth_stamp->p) *
+                                        T_depth_stamp->q.normalized() * config_.T_imu_cam *
+                                        c.T_cam_depth;
+  const Eigen::Matrix<float, 3, 4> T_cam_depth_now =
+      (T_map_cam.inverse() * T_map_depth).matrix().topRows<3>().cast<float>();
+  const std::span<const std::byte> bytes = nearest->pixels.bytes();
+  const std::size_t step = static_cast<std::size_t>(std::max(1, c.stride_px));
+  const float unit = nearest->depth_unit_m;
+  const float min_z = static_cast<float>(c.min_range_m), max_z = static_cast<float>(c.max_range_m);
+  const float inv_fx = static_cast<float>(1.0 / c.fx), inv_fy = static_cast<float>(1.0 / c.fy);
+  const float cx = static_cast<float>(c.cx), cy = static_cast<float>(c.cy);
+  for (std::size_t v = step / 2; v < nearest->height; v += step) {
+    const std::size_t row = v * nearest->stride;
+    if (row + 2 * static_cast<std::size_t>(nearest->width) > bytes.size()) break;
+    for (std::size_t u = step / 2; u < nearest->width; u += step) {
+      std::uint16_t raw = 0;
+      std::memcpy(&raw, bytes.data() + row + 2 * u, sizeof raw);
+      const float z = static_cast<float>(raw) * unit;
+      if (raw == 0 || z < min_z || z > max_z) continue;  // 0: no stereo match
+      const Eigen::Vector4f p_depth((static_cast<float>(u) - cx) * inv_fx * z,
+                                    (static_cast<float>(v) - cy) * inv_fy * z, z, 1.0f);
+      p_depth_cam_m_.push_back(T_cam_depth_now * p_depth);
+    }
+  }
+  return !p_depth_cam_m_.empty();
+}
+
 void CameraFrontEnd::drop_static_tracks(Run& run) {
   vision::FrontendFrame& frame = run.frame;
   fixed_ids_.clear();
@@ -205,6 +266,9 @@ void CameraFrontEnd::drop_static_tracks(Run& run) {
   frame.counts.depth_associated = static_cast<int>(
       std::count_if(frame.features.begin(), frame.features.end(),
                     [](const vision::FrontendFeature& f) { return std::isfinite(f.depth_m); }));
+  frame.counts.stereo_depth_associated = static_cast<int>(
+      std::count_if(frame.features.begin(), frame.features.end(),
+                    [](const vision::FrontendFeature& f) { return f.depth_from_stereo; }));
 }
 
 void CameraFrontEnd::account(Run& run, vision::FrontendStatus status) {
@@ -220,6 +284,7 @@ void CameraFrontEnd::account(Run& run, vision::FrontendStatus status) {
   f.extracted_total += static_cast<std::uint64_t>(frame.counts.extracted);
   f.features_total += static_cast<std::uint64_t>(frame.counts.features);
   f.depth_total += static_cast<std::uint64_t>(frame.counts.depth_associated);
+  f.stereo_depth_total += static_cast<std::uint64_t>(frame.counts.stereo_depth_associated);
   f.features = frame.counts.features;
   f.depth_associated = frame.counts.depth_associated;
   f.lidar_points = frame.counts.lidar_points;

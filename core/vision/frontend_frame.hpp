@@ -40,9 +40,11 @@ struct FrontendFeature {
   Eigen::Vector2f pixel_px = Eigen::Vector2f::Zero();  ///< in the distorted visible image [px]
   /// undistorted (x/z, y/z) in the visible camera frame [-]
   Eigen::Vector2d normalised = Eigen::Vector2d::Zero();
-  /// depth z in the visible camera frame from the lidar [m]; NaN when not associated
+  /// depth z in the visible camera frame from the lidar, or where it gives none from the
+  /// D435i's depth image [m]; NaN when not associated
   double depth_m = std::numeric_limits<double>::quiet_NaN();
   DepthStatus depth_status = DepthStatus::kNoPoints;
+  bool depth_from_stereo = false;  ///< depth_m is the depth image's, not the lidar's
   std::uint32_t track_length = 1;  ///< frames seen, this one included [1]
   /// change of `normalised` since the previous frame over the stamp difference [1/s]; zero for
   /// a new feature
@@ -60,15 +62,17 @@ struct StreamQualities {
 };
 
 struct FrontendCounts {
-  int previous = 0;          ///< features carried in from the previous frame [1]
-  int tracked = 0;           ///< of those, tracked by KLT (and the round trip) [1]
-  int ransac_inliers = 0;    ///< of those, kept by the fundamental-matrix RANSAC [1]
-  int crowded = 0;           ///< of those, dropped within min_distance of a longer track [1]
-  int extracted = 0;         ///< new features detected this frame [1]
-  int features = 0;          ///< features output [1]
-  int depth_associated = 0;  ///< of those, with a lidar depth [1]
-  int lidar_points = 0;      ///< lidar points in the depth kd-tree after culling [1]
-  int lines = 0;             ///< line features output (0 when lines are off) [1]
+  int previous = 0;                 ///< features carried in from the previous frame [1]
+  int tracked = 0;                  ///< of those, tracked by KLT (and the round trip) [1]
+  int ransac_inliers = 0;           ///< of those, kept by the fundamental-matrix RANSAC [1]
+  int crowded = 0;                  ///< of those, dropped within min_distance of a longer track [1]
+  int extracted = 0;                ///< new features detected this frame [1]
+  int features = 0;                 ///< features output [1]
+  int depth_associated = 0;         ///< of those, with a depth (lidar or depth image) [1]
+  int stereo_depth_associated = 0;  ///< of those, from the D435i's depth image [1]
+  int lidar_points = 0;             ///< lidar points in the depth kd-tree after culling [1]
+  int stereo_points = 0;            ///< depth-image points in its kd-tree after culling [1]
+  int lines = 0;                    ///< line features output (0 when lines are off) [1]
   /// seed 001's match success rate: inliers over the features carried in [0..1]; NaN on the
   /// first frame
   double match_success_rate() const {

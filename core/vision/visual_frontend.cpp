@@ -1,6 +1,7 @@
 #include "core/vision/visual_frontend.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "core/vision/image_view.hpp"
@@ -64,7 +65,8 @@ VisualFrontend::VisualFrontend(const FrontendConfig& config)
       quality_(config.quality),
       tracker_(config.tracker, config.visible_camera),
       line_tracker_(config.line),
-      depth_(config.depth, config.visible_camera) {
+      depth_(config.depth, config.visible_camera),
+      stereo_depth_(config.stereo_depth, config.visible_camera) {
   if (config.mode != FrontendMode::kVisible) {
     aligner_ = std::make_unique<ThermalAligner>(config.visible_camera, config.thermal_camera,
                                                 config.T_cam_thermal, config.thermal_align);
@@ -233,6 +235,8 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
   begin(FrontendStep::kDepth);
   const bool lidar = !input.p_cam_m.empty();
   if (lidar) depth_.set_points(input.p_cam_m);
+  const bool stereo = !input.p_depth_cam_m.empty();
+  if (stereo) stereo_depth_.set_points(input.p_depth_cam_m);
   const double dt = has_previous_ ? (out.stamp - previous_stamp_).seconds() : 0.0;
   std::size_t previous_index = 0;
   for (const Track& t : tracker_.tracks()) {
@@ -247,6 +251,16 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
       f.depth_status = d.status;
       if (d.status == DepthStatus::kOk) ++out.counts.depth_associated;
     }
+    if (stereo && !std::isfinite(f.depth_m)) {
+      const DepthResult d = stereo_depth_.depth(t.normalised);
+      if (d.status == DepthStatus::kOk) {
+        f.depth_m = d.depth_m;
+        f.depth_status = d.status;
+        f.depth_from_stereo = true;
+        ++out.counts.depth_associated;
+        ++out.counts.stereo_depth_associated;
+      }
+    }
     // Both lists are in id order: walk the previous one alongside.
     while (previous_index < previous_.size() && previous_[previous_index].first < t.id) {
       ++previous_index;
@@ -257,6 +271,7 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     out.features.push_back(f);
   }
   out.counts.lidar_points = lidar ? static_cast<int>(depth_.tree_points()) : 0;
+  out.counts.stereo_points = stereo ? static_cast<int>(stereo_depth_.tree_points()) : 0;
   end(FrontendStep::kDepth);
 
   previous_.clear();

@@ -53,6 +53,17 @@ struct FrontendConfig {
   bool lines = false;  ///< LSD line features (seed 001); several ms per frame
   LineConfig line;
   DepthConfig depth;
+  /// Depth from the D435i's depth image for the features the lidar gives none
+  /// (FrontendInput::p_depth_cam_m). Its points are dense (one per few pixels), so three
+  /// neighbours that span more than a few decimetres straddle a depth edge.
+  DepthConfig stereo_depth = [] {
+    DepthConfig c;
+    c.max_span_m = 0.3;
+    c.min_range_m = 0.3;
+    c.max_range_m = 10.0;
+    c.max_extrapolation_m = 0.1;
+    return c;
+  }();
 };
 
 /// One frame pair. cv::Mat headers may wrap driver buffers (see image_view.hpp); nothing is
@@ -69,6 +80,9 @@ struct FrontendInput {
   /// recent deskewed lidar points in the visible camera frame at the tracked image's stamp [m];
   /// empty: no depth this frame
   std::span<const Eigen::Vector3f> p_cam_m;
+  /// points of the D435i's depth image in the same frame [m]: depth for the features the lidar
+  /// gives none (FrontendConfig::stereo_depth); empty: none this frame
+  std::span<const Eigen::Vector3f> p_depth_cam_m;
 };
 
 /// Wraps core Images (either may be null) into an input without copying their pixels.
@@ -125,6 +139,7 @@ class VisualFrontend {
   FeatureTracker tracker_;
   LineTracker line_tracker_;
   DepthAssociator depth_;
+  DepthAssociator stereo_depth_;
   FrontendStepProbe* probe_ = nullptr;
 
   cv::Mat visible_grey_, thermal_grey_, thermal_aligned_, thermal_native_, fused_grey_;

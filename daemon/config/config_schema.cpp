@@ -274,7 +274,20 @@ const Field kSchema[] = {
     F("realsense_imu.dev_dir", realsense_imu.dev_dir, "/dev", "", 0, 0, "",
       "where the IIO character devices (iio:deviceN) are"),
     F("depth_camera.enabled", depth_camera.enabled, "false", "", 0, 0, "",
-      "simulate and record the D435i depth stream (posed has no depth stage: a replay skips it)"),
+      "read the D435i depth node live (posectl sim: simulate it); a replay uses a recorded depth "
+      "stream whatever this says"),
+    F("depth_camera.device", depth_camera.device, "\"\"", "", 0, 0, "",
+      "V4L2 node of the depth stream, or /dev/v4l/by-id/..."),
+    F("depth_camera.source", depth_camera.source, "v4l2", "", 0, 0, "v4l2",
+      "how the depth node is read (V4L2 with its D4xx metadata node)"),
+    F("depth_camera.format", depth_camera.format, "z16", "", 0, 0, "z16",
+      "pixel format of the depth node"),
+    F("depth_camera.latency_s", depth_camera.latency_s, "0.041", "s", 0, 1, "",
+      "least frame arrival minus exposure midpoint (the ASIC's matching, half a frame at 15 Hz, "
+      "plus USB)"),
+    F("depth_camera.clock_kind", depth_camera.clock_kind, "hardware_ns", "", 0, 0,
+      "hardware_ns|none",
+      "how the depth node stamps frames (the D4xx metadata's hardware clock, the colour node's)"),
     F("depth_camera.width", depth_camera.width, "640", "px", 1, 1280, "",
       "depth image width (the D435i sends 640x480 or 848x480 at 15 Hz)"),
     F("depth_camera.height", depth_camera.height, "480", "px", 1, 800, "", "depth image height"),
@@ -295,6 +308,21 @@ const Field kSchema[] = {
       "disparity search)"),
     F("depth_camera.max_range_m", depth_camera.max_range_m, "10", "m", 0.1, 65, "",
       "farther surfaces read 0 (the D435's ideal range ends near 10 m)"),
+    F("depth_camera.feature_depth", depth_camera.feature_depth, "false", "", 0, 0, "",
+      "camera features the lidar gives no depth take the depth image's (the floor ahead and the "
+      "walls beside the robot, between and below the lidar's rings); off by default: on the "
+      "simulated rigs it changed no scenario's error beyond its seed-to-seed spread "
+      "(docs/estimator.md) and costs 4 % of a replay's speed"),
+    F("depth_camera.feature_stride_px", depth_camera.feature_stride_px, "4", "px", 1, 64, "",
+      "one depth point per stride x stride pixels goes to the features' depth search"),
+    F("depth_camera.feature_min_range_m", depth_camera.feature_min_range_m, "0.3", "m", 0, 10, "",
+      "nearer depths are not used for features (the robot itself)"),
+    F("depth_camera.feature_max_range_m", depth_camera.feature_max_range_m, "4", "m", 0.2, 65, "",
+      "further depths are not used for features: stereo error grows with z^2 (37 mm at 3 m)"),
+    F("depth_camera.feature_max_span_m", depth_camera.feature_max_span_m, "0.3", "m", 0.01, 10, "",
+      "a feature whose 3 nearest depth points span more straddles a depth edge: no depth"),
+    F("depth_camera.feature_max_offset_s", depth_camera.feature_max_offset_s, "0.04", "s", 0, 1, "",
+      "a depth image further from a camera frame's stamp is not used for it"),
 
     F("sync.pairing_tolerance_s", sync.pairing_tolerance_s, "0.02", "s", 0.0001, 0.5, "",
       "visible and thermal frames further apart than this are not paired"),

@@ -131,18 +131,21 @@ struct CameraSection {
   std::string clock_kind;  ///< hardware_ns (D435i metadata) | none (UVC thermal)
 };
 
-/// The D435i's depth node (Z16 from the left IR imager of its stereo pair). posed has no depth
-/// stage yet: the simulator emits this stream and a replay skips it.
-struct DepthCameraSection {
-  bool enabled = false;
-  int width = 0;                          ///< [px]
-  int height = 0;                         ///< [px]
-  double rate_hz = 0;                     ///< [Hz]
-  double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics of the rectified depth image [px]
-  double baseline_m = 0;                  ///< stereo baseline, left to right IR imager [m]
-  double depth_unit_m = 0;                ///< metres per Z16 count [m]
-  double min_range_m = 0;                 ///< nearer: no stereo match, reported 0 [m]
-  double max_range_m = 0;                 ///< farther: reported 0 [m]
+/// The D435i's depth node (Z16 from the left IR imager of its stereo pair): read like a camera
+/// (the CameraSection fields; fx..cy are the rectified depth image's, no distortion), it gives
+/// the camera features depth where the lidar gives none.
+struct DepthCameraSection : CameraSection {
+  double baseline_m = 0;    ///< stereo baseline, left to right IR imager [m]
+  double depth_unit_m = 0;  ///< metres per Z16 count [m]
+  double min_range_m = 0;   ///< nearer: no stereo match, reported 0 [m]
+  double max_range_m = 0;   ///< farther: reported 0 [m]
+  /// features the lidar gives no depth take the depth image's
+  bool feature_depth = false;
+  int feature_stride_px = 4;           ///< one depth point per stride x stride pixels [px]
+  double feature_min_range_m = 0.3;    ///< nearer depths are not used [m]
+  double feature_max_range_m = 4.0;    ///< further depths are not used [m]
+  double feature_max_span_m = 0.3;     ///< a feature's 3 depth points spanning more: none [m]
+  double feature_max_offset_s = 0.04;  ///< depth image to frame stamp, at most [s]
 };
 
 /// The D435i's own IMU (BMI055 over IIO HID): the A9's backup. When the A9 falls silent the

@@ -13,7 +13,15 @@ namespace posed::pipeline {
 namespace camera = drivers::camera;
 
 const config::CameraSection& camera_section(const config::PosedConfig& config, CameraStream s) {
-  return s == CameraStream::kVisible ? config.visible_camera : config.thermal_camera;
+  switch (s) {
+    case CameraStream::kVisible:
+      return config.visible_camera;
+    case CameraStream::kThermal:
+      return config.thermal_camera;
+    case CameraStream::kDepth:
+      return config.depth_camera;
+  }
+  return config.visible_camera;
 }
 
 std::size_t CameraStage::pool_buffers(const config::PosedConfig& config) {
@@ -59,6 +67,9 @@ camera::FrameDecoder* CameraStage::decoder_for(std::string_view wire_format, std
   c.stride_bytes = stride_bytes;
   // A thermal camera's MJPEG is grey; the fusion core's thermal path wants one channel.
   c.mjpeg_to_mono8 = stream_ == CameraStream::kThermal;
+  if (stream_ == CameraStream::kDepth) {
+    c.depth_unit_m = static_cast<float>(config_.depth_camera.depth_unit_m);
+  }
   decoder_ = std::make_unique<camera::FrameDecoder>(c);
   decoder_format_ = std::string(wire_format);
   decoder_width_ = width;
@@ -106,8 +117,8 @@ void CameraStage::handle_frame(const drivers::RawChunk& chunk, std::span<const s
 }
 
 void CameraStage::run() {
-  apply_thread_policy(stream_ == CameraStream::kVisible ? "posed-visible" : "posed-thermal",
-                      config_.threads.camera_source);
+  const std::string thread = "posed-" + std::string(to_string(stream_));
+  apply_thread_policy(thread, config_.threads.camera_source);
   drivers::RawChunk chunk;
   SourceReader reader(to_string(stream_), source_, heartbeat_, counters_);
   std::uint64_t frames = 0;

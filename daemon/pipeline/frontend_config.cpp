@@ -111,6 +111,20 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
                 std::max(config.visible_camera.latency_s, config.thermal_camera.latency_s) + 0.05);
   c.depth.window = Duration::from_seconds(s.depth_window_s);
   c.depth.max_points_per_scan = static_cast<std::size_t>(s.depth_points_per_scan);
+  const config::DepthCameraSection& d = config.depth_camera;
+  c.depth_image.enabled = d.feature_depth;
+  c.depth_image.fx = d.fx;
+  c.depth_image.fy = d.fy;
+  c.depth_image.cx = d.cx;
+  c.depth_image.cy = d.cy;
+  c.depth_image.T_cam_depth = to_isometry(config.extrinsics.T_cam_depth);
+  c.depth_image.stride_px = d.feature_stride_px;
+  c.depth_image.min_range_m = d.feature_min_range_m;
+  c.depth_image.max_range_m = d.feature_max_range_m;
+  c.depth_image.max_offset = Duration::from_seconds(d.feature_max_offset_s);
+  f.stereo_depth.max_span_m = d.feature_max_span_m;
+  f.stereo_depth.min_range_m = d.feature_min_range_m;
+  f.stereo_depth.max_range_m = d.feature_max_range_m;
   return c;
 }
 

@@ -108,7 +108,8 @@ void FusionStage::emit_states() {
 
 template <class Item>
 void FusionStage::took(std::size_t stream, const Item& item) {
-  static constexpr const char* kNames[] = {"imu", "lidar", "visible", "thermal", "realsense_imu"};
+  static constexpr const char* kNames[] = {"imu",     "lidar",         "visible",
+                                           "thermal", "realsense_imu", "depth"};
   const HostTime stamp = stamp_of(item);
   newest_received_ = std::max(newest_received_, item.received);
   newest_stamp_ = std::max(newest_stamp_, stamp);
@@ -187,19 +188,22 @@ void FusionStage::run() {
   Lane<ImageItem> visible(inputs_.visible);
   Lane<ImageItem> thermal(inputs_.thermal);
   Lane<ImuItem> backup_imu(inputs_.backup_imu);
+  Lane<ImageItem> depth(inputs_.depth);
 
   // Which lane goes next: the oldest head; on equal stamps the IMU first (a scan or frame ending
   // exactly at an IMU sample finds it already in the core), then scans, visible, thermal, and
-  // the D435i's IMU (used only in a silent A9's place). Stamp order waits for every open lane.
-  enum class Next { kNone, kImu, kScan, kVisible, kThermal, kBackupImu };
+  // the D435i's IMU (used only in a silent A9's place), its depth images. Stamp order waits for
+  // every open lane.
+  enum class Next { kNone, kImu, kScan, kVisible, kThermal, kBackupImu, kDepth };
   const auto next = [&] {
     imu.refill();
     scans.refill();
     visible.refill();
     thermal.refill();
     backup_imu.refill();
+    depth.refill();
     if (in_stamp_order_ && (imu.waiting() || scans.waiting() || visible.waiting() ||
-                            thermal.waiting() || backup_imu.waiting())) {
+                            thermal.waiting() || backup_imu.waiting() || depth.waiting())) {
       return Next::kNone;
     }
     Next best = Next::kNone;
@@ -215,10 +219,12 @@ void FusionStage::run() {
     consider(visible, Next::kVisible);
     consider(thermal, Next::kThermal);
     consider(backup_imu, Next::kBackupImu);
+    consider(depth, Next::kDepth);
     return best;
   };
   const auto all_ended = [&] {
-    return imu.ended() && scans.ended() && visible.ended() && thermal.ended() && backup_imu.ended();
+    return imu.ended() && scans.ended() && visible.ended() && thermal.ended() &&
+           backup_imu.ended() && depth.ended();
   };
 
   std::uint64_t handed_since_figures = 0;
@@ -272,6 +278,14 @@ void FusionStage::run() {
           core_->add_image(CameraStream::kThermal, std::move(item.image), produced_);
           tag_new_states();
           counters_.frames_fused[1].fetch_add(1, std::memory_order_relaxed);
+          break;
+        }
+        case Next::kDepth: {
+          ImageItem item = depth.take();
+          took(5, item);
+          core_->add_image(CameraStream::kDepth, std::move(item.image), produced_);
+          tag_new_states();
+          counters_.frames_fused[2].fetch_add(1, std::memory_order_relaxed);
           break;
         }
         case Next::kNone:

@@ -35,18 +35,18 @@ struct FusionCounters {
   std::atomic<std::uint64_t> states{0};       ///< states the core produced
   std::atomic<std::uint64_t> scans_fused{0};  ///< scans handed to the core
   /// camera frames handed to the core, by CameraStream
-  std::atomic<std::uint64_t> frames_fused[2] = {0, 0};
+  std::atomic<std::uint64_t> frames_fused[3] = {0, 0, 0};
   std::atomic<EstimatorMode> mode{EstimatorMode::kAligning};
   /// stamp of the newest measurement the core took: where the merge is (a replay's data clock)
   /// [ns]
   std::atomic<std::int64_t> newest_stamp_ns{0};
   /// the newest stamp the core took per stream: imu, lidar (a scan's end), visible, thermal,
-  /// realsense_imu [ns]. A replay's stream health: merged in stamp order, a stream that fell
+  /// realsense_imu, depth [ns]. A replay's stream health: merged in stamp order, a stream that fell
   /// silent shows as the merge passing it by.
-  std::atomic<std::int64_t> newest_stamp_by_stream_ns[5] = {0, 0, 0, 0, 0};
+  std::atomic<std::int64_t> newest_stamp_by_stream_ns[6] = {0, 0, 0, 0, 0, 0};
   /// per stream, in stamp order (replays only): a malformed or dropped sample came before one
   /// the merge took within kStreamDegradedFor of its newest stamp
-  std::atomic<bool> degraded_by_stream[5] = {false, false, false, false, false};
+  std::atomic<bool> degraded_by_stream[6] = {false, false, false, false, false, false};
   /// the D435i IMU standing in for the A9 (imu_failover.hpp): now, how often, how many samples
   std::atomic<bool> imu_on_backup{false};
   std::atomic<std::uint64_t> imu_failovers{0};
@@ -83,7 +83,14 @@ struct FusionInputs {
   SpscQueue<ImageItem>* thermal = nullptr;  ///< null without the thermal camera
   /// the D435i's IMU, used while the A9 is silent; null without it or realsense_imu.failover
   SpscQueue<ImuItem>* backup_imu = nullptr;
+  SpscQueue<ImageItem>* depth = nullptr;  ///< the D435i's depth images; null without them
 };
+
+/// A camera stream's index among the fusion stage's streams (imu, lidar, visible, thermal,
+/// realsense_imu, depth).
+constexpr std::size_t fusion_stream_index(CameraStream s) {
+  return s == CameraStream::kVisible ? 2 : s == CameraStream::kThermal ? 3 : 5;
+}
 
 class FusionStage {
  public:
@@ -134,25 +141,25 @@ class FusionStage {
   HostTime newest_received_;
   /// the newest stamp the core took (FusionCounters::newest_stamp_ns)
   HostTime newest_stamp_;
-  /// The core took `item` of `stream` (0..4: imu, lidar, visible, thermal, realsense_imu): the
-  /// newest stamps and receive time move on and, in stamp order, that stream is heard again if it
-  /// was silent, and every stream the merge has passed by more than kStreamStaleAfter falls silent;
-  /// a stream whose item counts more bad samples before it than the last is degraded until the
-  /// merge has passed that by kStreamDegradedFor; all logged with the data's time.
+  /// The core took `item` of `stream` (0..5: imu, lidar, visible, thermal, realsense_imu, depth):
+  /// the newest stamps and receive time move on and, in stamp order, that stream is heard again if
+  /// it was silent, and every stream the merge has passed by more than kStreamStaleAfter falls
+  /// silent; a stream whose item counts more bad samples before it than the last is degraded until
+  /// the merge has passed that by kStreamDegradedFor; all logged with the data's time.
   template <class Item>
   void took(std::size_t stream, const Item& item);
-  static constexpr std::size_t kStreams = 5;
+  static constexpr std::size_t kStreams = 6;
   /// per stream: it has delivered at least one sample
-  bool heard_[kStreams] = {false, false, false, false, false};
+  bool heard_[kStreams] = {};
   /// per stream: its newest stamp (published as FusionCounters::newest_stamp_by_stream_ns)
   HostTime stream_stamp_[kStreams];
   /// per stream, in stamp order: the merge has passed its newest stamp by kStreamStaleAfter
-  bool silent_[kStreams] = {false, false, false, false, false};
+  bool silent_[kStreams] = {};
   /// per stream, in stamp order: the bad count the newest item carried (Item::bad_before), when
   /// it last rose, and whether that is within kStreamDegradedFor of the merge
-  std::uint64_t bad_seen_[kStreams] = {0, 0, 0, 0, 0};
+  std::uint64_t bad_seen_[kStreams] = {};
   HostTime bad_rose_[kStreams];
-  bool degraded_[kStreams] = {false, false, false, false, false};
+  bool degraded_[kStreams] = {};
   /// which IMU feeds the core, decided in data order
   ImuFailover failover_;
 };

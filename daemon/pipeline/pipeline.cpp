@@ -24,7 +24,8 @@ namespace posed::pipeline {
 
 namespace {
 
-constexpr CameraStream kCameraStreams[] = {CameraStream::kVisible, CameraStream::kThermal};
+constexpr CameraStream kCameraStreams[] = {CameraStream::kVisible, CameraStream::kThermal,
+                                           CameraStream::kDepth};
 std::size_t index_of(CameraStream s) { return static_cast<std::size_t>(s); }
 std::string stage_name(CameraStream s) { return std::string(to_string(s)) + "_source"; }
 
@@ -216,8 +217,9 @@ bool Pipeline::start(std::string& error) {
   }
   // Recordings and generators at full speed: merge by stamp so replays are deterministic.
   bool in_stamp_order = !sources_.imu->live();
-  for (const drivers::Source* s : {sources_.lidar.get(), sources_.visible.get(),
-                                   sources_.thermal.get(), sources_.realsense_imu.get()}) {
+  for (const drivers::Source* s :
+       {sources_.lidar.get(), sources_.visible.get(), sources_.thermal.get(),
+        sources_.realsense_imu.get(), sources_.depth.get()}) {
     if (s != nullptr && s->live()) in_stamp_order = false;
   }
   estimator::LioEstimator* lio = nullptr;
@@ -271,7 +273,7 @@ bool Pipeline::start(std::string& error) {
     fusion_stage_ = std::make_unique<FusionStage>(
         config_, std::move(core),
         FusionInputs{&imu_queue_, scan_queue_.get(), image_queues_[0].get(), image_queues_[1].get(),
-                     backup_imu_queue_.get()},
+                     backup_imu_queue_.get(), image_queues_[2].get()},
         in_stamp_order, state_queue_, fusion_ready_, state_ready_, beat, *fusion_counters_,
         handover, std::move(scan_observers));
     return [this] { fusion_stage_->run(); };
@@ -327,6 +329,7 @@ void Pipeline::request_stop() {
   if (sources_.lidar) sources_.lidar->request_stop();
   if (sources_.visible) sources_.visible->request_stop();
   if (sources_.thermal) sources_.thermal->request_stop();
+  if (sources_.depth) sources_.depth->request_stop();
   if (sources_.realsense_imu) sources_.realsense_imu->request_stop();
 }
 
@@ -426,7 +429,7 @@ PipelineStatus Pipeline::status() const {
     StreamStatus camera;
     camera.name = std::string(to_string(s));
     fill_stream_status(camera, camera_counters_[index_of(s)], *sources_.camera(s), health_now,
-                       health_[2 + index_of(s)], consumed(2 + index_of(s)));
+                       health_[fusion_stream_index(s)], consumed(fusion_stream_index(s)));
     st.streams.push_back(std::move(camera));
     st.camera_frames_fused[index_of(s)] = fusion_counters_->frames_fused[index_of(s)].load();
   }

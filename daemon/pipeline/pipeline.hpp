@@ -62,6 +62,8 @@ struct PipelineSources {
   std::unique_ptr<drivers::Source> thermal;
   /// the D435i's IMU: IIO HID accel (channel 0) and gyro (1) records; optional, the A9's backup
   std::unique_ptr<drivers::Source> realsense_imu;
+  /// the D435i's depth node: Z16 frames (channel 0) and their D4xx metadata (1); optional
+  std::unique_ptr<drivers::Source> depth;
   /// The Velodyne calibration the lidar stream was recorded with (its file's text, from the
   /// recording; `posed --replay FILE --recorded-config`), used instead of lidar.calibration so a
   /// replay decodes the packets as the robot did; empty: lidar.calibration as configured.
@@ -77,10 +79,10 @@ struct PipelineSources {
 
   /// The camera Source of a stream (null when absent).
   std::unique_ptr<drivers::Source>& camera(CameraStream s) {
-    return s == CameraStream::kVisible ? visible : thermal;
+    return s == CameraStream::kVisible ? visible : s == CameraStream::kThermal ? thermal : depth;
   }
   const drivers::Source* camera(CameraStream s) const {
-    return s == CameraStream::kVisible ? visible.get() : thermal.get();
+    return const_cast<PipelineSources*>(this)->camera(s).get();
   }
 
   /// Calls `f(std::unique_ptr<drivers::Source>&)` on every slot above, set or not, so code that
@@ -93,6 +95,7 @@ struct PipelineSources {
     f(visible);
     f(thermal);
     f(realsense_imu);
+    f(depth);
   }
 };
 
@@ -189,7 +192,7 @@ class Pipeline {
   std::atomic<std::int64_t> a9_newest_ns_{0};
   std::unique_ptr<SpscQueue<ScanItem>> scan_queue_;
   /// per CameraStream; null without that camera
-  std::unique_ptr<SpscQueue<ImageItem>> image_queues_[2];
+  std::unique_ptr<SpscQueue<ImageItem>> image_queues_[3];  // by CameraStream
   SpscQueue<StateItem> state_queue_;
   /// signalled by every source stage: the fusion stage has input
   Wakeup fusion_ready_;
@@ -198,11 +201,11 @@ class Pipeline {
   /// status(): each stream's health between reports (imu, lidar, visible, thermal,
   /// realsense_imu)
   mutable std::mutex health_mutex_;
-  mutable StreamHealthMemory health_[5];
+  mutable StreamHealthMemory health_[6];  // by FusionStage stream index
   StreamCounters imu_counters_;
   StreamCounters realsense_imu_counters_;
   StreamCounters lidar_counters_;
-  StreamCounters camera_counters_[2];
+  StreamCounters camera_counters_[3];
   std::unique_ptr<LidarScanCounters> scan_counters_;
   std::unique_ptr<FusionCounters> fusion_counters_;
   /// every stage this pipeline runs, in stage_names() order (add_stage())
@@ -215,7 +218,7 @@ class Pipeline {
   std::unique_ptr<ImuStage> imu_stage_;
   std::unique_ptr<RealsenseImuStage> realsense_imu_stage_;
   std::unique_ptr<LidarStage> lidar_stage_;
-  std::unique_ptr<CameraStage> camera_stages_[2];
+  std::unique_ptr<CameraStage> camera_stages_[3];
   /// the camera front end's thread (frontend.own_thread) and its heartbeat; declared before the
   /// fusion stage, whose core posts to it, so it outlives that core
   Heartbeat camera_lane_beat_{"camera_frontend"};

@@ -54,7 +54,7 @@ struct PipelineStatus {
   std::uint64_t lidar_points = 0;       ///< points in those scans
   std::uint64_t lidar_scans_fused = 0;  ///< scans the fusion core received
   /// camera frames the fusion core received, by CameraStream (visible, thermal)
-  std::uint64_t camera_frames_fused[2] = {0, 0};
+  std::uint64_t camera_frames_fused[3] = {0, 0, 0};
   /// the estimator's own figures (scans used, degeneracy, biases, re-initialisations)
   FusionFigures estimator;
   /// which IMU the estimate runs on: "a9", or "d435i" while it stands in for a silent A9; empty

@@ -63,9 +63,10 @@ std::map<std::string, std::string> recording_metadata(const config::PosedConfig&
     md["posed.lidar.address"] = config.lidar.address;
     md[std::string(raw::kLidarCalibrationKey)] = config.lidar.calibration;
     md[std::string(raw::kLidarCalibrationTextKey)] = read_text_file(config.lidar.calibration);
-  } else if (stream == "visible" || stream == "thermal") {
-    const config::CameraSection& camera =
-        stream == "visible" ? config.visible_camera : config.thermal_camera;
+  } else if (stream == "visible" || stream == "thermal" || stream == "depth") {
+    const config::CameraSection& camera = stream == "visible"   ? config.visible_camera
+                                          : stream == "thermal" ? config.thermal_camera
+                                                                : config.depth_camera;
     const std::string prefix = "posed." + std::string(stream) + ".";
     md[prefix + "device"] = camera.device;
     md[prefix + "source"] = camera.source;

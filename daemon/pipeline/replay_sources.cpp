@@ -123,12 +123,13 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
       }
     }
   }
-  // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp).
-  // Other streams (the D435i's depth) have no stage: listed, said once in the log,
-  // never read.
+  // Cameras replay as raw frames or as imported sensor_msgs/Image (camera_stage_ros1.cpp); the
+  // D435i's depth node too when features take its depth (depth_camera.feature_depth). Other
+  // streams have no stage: listed, said once in the log, never read.
   const auto replay_camera = [&](const std::string& stream) { return streams.count(stream) != 0; };
   if (replay_camera("visible")) out.built.sources.visible = make("visible");
   if (replay_camera("thermal")) out.built.sources.thermal = make("thermal");
+  if (replay_camera("depth") && options.depth) out.built.sources.depth = make("depth");
   // The D435i's IMU as raw IIO records (posed --record, posectl sim --realsense-imu): the A9's
   // backup. An imported sensor_msgs/Imu of it has no stage yet.
   bool rsimu_raw = false;
@@ -142,9 +143,13 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   std::string skipped;
   for (const auto& s : streams) {
     const bool replayed = s == "imu" || s == "lidar" || s == "visible" || s == "thermal" ||
+                          (s == "depth" && out.built.sources.depth) ||
                           (s == "realsense_imu" && out.built.sources.realsense_imu);
     out.streams += (out.streams.empty() ? "" : ", ") + s + (replayed ? "" : " (not replayed)");
-    if (!replayed) skipped += (skipped.empty() ? "" : ", ") + s;
+    if (!replayed) {
+      skipped += (skipped.empty() ? "" : ", ") + s;
+      if (s == "depth") skipped += " (depth_camera.feature_depth is false)";
+    }
   }
   if (!skipped.empty()) {
     POSED_LOG_NOTICE("%s: no pipeline stage for stream(s) %s: not replayed", options.path.c_str(),

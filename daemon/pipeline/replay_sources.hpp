@@ -39,6 +39,8 @@ struct ReplayOptions {
   /// replaying with the configuration the recording was made with (--recorded-config): the lidar
   /// packets are decoded with the calibration recorded beside them, not lidar.calibration's file
   bool recorded_config = false;
+  /// replay the D435i's depth stream, if recorded (depth_camera.feature_depth: its only use)
+  bool depth = true;
 };
 
 struct ReplaySources {

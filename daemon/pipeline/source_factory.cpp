@@ -91,9 +91,10 @@ bool make_camera_source(const config::PosedConfig& config, CameraStream stream,
   v.width = static_cast<std::uint32_t>(section.width);
   v.height = static_cast<std::uint32_t>(section.height);
   v.fps = static_cast<std::uint32_t>(std::lround(section.rate_hz));
-  if (stream == CameraStream::kVisible) {
-    // The D435i: the colour node with its uvcvideo metadata node, whose hardware timestamps
-    // the camera stage's clock prefers (frames still flow when the metadata node is missing).
+  if (stream == CameraStream::kVisible || stream == CameraStream::kDepth) {
+    // The D435i: the colour (or depth) node with its uvcvideo metadata node, whose hardware
+    // timestamps the camera stage's clock prefers (frames still flow when the metadata node is
+    // missing).
     drivers::camera::D4xxVideoConfig d4xx;
     d4xx.video = std::move(v);
     sources.camera(stream) = std::make_unique<drivers::camera::D4xxVideoSource>(
@@ -130,7 +131,8 @@ BuiltSources make_sources(const config::PosedConfig& config, std::string& error)
     error = "imu.source '" + config.imu.source + "' has no Source in make_sources()";
   }
   if (!error.empty()) return built;
-  for (const CameraStream stream : {CameraStream::kVisible, CameraStream::kThermal}) {
+  for (const CameraStream stream :
+       {CameraStream::kVisible, CameraStream::kThermal, CameraStream::kDepth}) {
     if (!make_camera_source(config, stream, built.sources, error)) {
       built.sources = {};
       return built;

@@ -1,8 +1,9 @@
 // Every camera stream the simulator writes, replayed by posed as a user runs it: `posectl sim
 // --depth --thermal-format y16` records colour frames with their D4xx metadata, 16-bit raw
-// thermal frames and the D435i's depth stream; `posed --replay --max-speed` decodes the colour
-// and y16 thermal frames (y16 -> mono16) without a malformed one, says once that the depth
-// stream has no stage, and exits cleanly.
+// thermal frames and the D435i's depth stream; `posed --replay --max-speed` decodes the colour,
+// y16 thermal (y16 -> mono16) and Z16 depth frames without a malformed one, stamps the depth
+// frames from their hardware clock, gives camera features the depth image's depth where the
+// lidar gives none, and exits cleanly.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -29,10 +30,10 @@ std::size_t count(const std::string& text, const std::string& needle) {
   return n;
 }
 
-TEST(SimCamerasReplay, DepthIsSkippedOnceAndRawThermalDecodes) {
+TEST(SimCamerasReplay, DepthAndRawThermalDecodeAndTheDepthImageGivesFeaturesDepth) {
   TempDir dir;
   const std::string recording = dir.file("cameras.mcap");
-  int visible_frames = 0, thermal_frames = 0;
+  int visible_frames = 0, thermal_frames = 0, depth_frames = 0;
   {
     PosedProcess sim({simulator(), "sim", "--scenario", "room", "--duration", "3", "--seed", "3",
                       "--depth", "--thermal-format", "y16", "--config",
@@ -49,21 +50,22 @@ TEST(SimCamerasReplay, DepthIsSkippedOnceAndRawThermalDecodes) {
     thermal_frames = std::stoi(m[2]);
     EXPECT_NEAR(visible_frames, 45, 2);  // 15 Hz
     EXPECT_NEAR(thermal_frames, 75, 2);  // 25 Hz
-    EXPECT_NEAR(std::stoi(m[3]), 45, 2);
+    depth_frames = std::stoi(m[3]);
+    EXPECT_NEAR(depth_frames, 45, 2);
   }
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
                                   "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+                                  "/config/cyclonedds-loopback.xml\n"
+                                  "depth_camera:\n  feature_depth: true\n");
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--wait-subscribers", "0"},
                      {}, dir);
   ASSERT_EQ(posed.wait_for_exit(120s), 0) << posed.err();
   const std::string out = posed.out(), err = posed.err();
-  EXPECT_EQ(count(err, "no pipeline stage for stream(s) depth: not replayed"), 1u) << err;
+  EXPECT_EQ(count(err, "not replayed"), 0u) << err;
   EXPECT_EQ(count(err, "error"), 0u) << err;
-  EXPECT_NE(out.find("(depth (not replayed), imu, lidar, thermal, visible)"), std::string::npos)
-      << out;
+  EXPECT_NE(out.find("(depth, imu, lidar, thermal, visible)"), std::string::npos) << out;
   // Every frame decoded, none malformed or dropped; colour stamped from its hardware clock.
   std::smatch m;
   ASSERT_TRUE(std::regex_search(out, m,
@@ -80,6 +82,24 @@ TEST(SimCamerasReplay, DepthIsSkippedOnceAndRawThermalDecodes) {
   EXPECT_EQ(std::stoi(m[1]), visible_frames);
   EXPECT_EQ(std::stoi(m[2]), 0);
   EXPECT_EQ(m[4], "locked");
+  ASSERT_TRUE(std::regex_search(
+      out, m,
+      std::regex(R"(depth +(\d+) decoded .*, (\d+) malformed, (\d+) dropped; clock (\w+))")))
+      << out;
+  EXPECT_EQ(std::stoi(m[1]), depth_frames);
+  EXPECT_EQ(std::stoi(m[2]), 0);
+  EXPECT_EQ(std::stoi(m[3]), 0);
+  EXPECT_EQ(m[4], "locked");
+  // The room's near walls and floor, below and between the lidar's rings: the depth image gives
+  // features depth the lidar does not, on every frame after the estimator has aligned (about a
+  // second of the three: before, no pose moves a depth image to a frame's stamp).
+  ASSERT_TRUE(std::regex_search(
+      out, m,
+      std::regex(
+          R"(visible: (\d+) frames .*depth-image depth for ([0-9.]+) % more \((\d+) frames)")))
+      << out;
+  EXPECT_GT(std::stod(m[2]), 1.0);
+  EXPECT_GE(2 * std::stoi(m[3]), std::stoi(m[1]));
 }
 
 }  // namespace sim_cameras_replay_test

@@ -123,10 +123,15 @@ TEST(RecordingTap, CamerasCarryTheirDeviceAndFormatAndOtherStreamsTheConfigOnly)
   EXPECT_EQ(thermal.at("posed.thermal.device"), config.thermal_camera.device);
   EXPECT_EQ(thermal.at("posed.thermal.format"), "y16");
   EXPECT_EQ(thermal.at("posed.thermal.source"), "v4l2");
-  // A Source added later (a depth camera) needs no change here: the configuration goes with it.
+  // The D435i's depth node is a camera like the others.
+  config.depth_camera.device = "/dev/video2";
   const auto depth = recording_metadata(config, "depth");
-  EXPECT_EQ(depth.size(), 1u);
-  EXPECT_EQ(depth.at("posed.config"), config::print_config(config));
+  EXPECT_EQ(depth.at("posed.depth.device"), "/dev/video2");
+  EXPECT_EQ(depth.at("posed.depth.format"), "z16");
+  // A Source added later needs no change here: the configuration goes with it.
+  const auto other = recording_metadata(config, "realsense_imu");
+  EXPECT_EQ(other.size(), 1u);
+  EXPECT_EQ(other.at("posed.config"), config::print_config(config));
 }
 
 }  // namespace recording_tap_test
