@@ -65,7 +65,7 @@ bool FrontendTimeline::open(std::string& error) {
   }
   // t_s: true time since the start for a simulated recording, else the host clock.
   std::fprintf(csv_,
-               "t_s,mode,status,carried_in,inliers,extracted,features,with_depth,"
+               "t_s,mode,status,carried_in,tracked,inliers,crowded,extracted,features,with_depth,"
                "confidence_visible,confidence_thermal,confidence_fused,"
                "gradient_visible,gradient_thermal,gradient_fused\n");
   return true;
@@ -78,10 +78,10 @@ void FrontendTimeline::on_frame(const vision::FrontendFrame& frame, const vision
                                       &frame.quality.fused};
   if (csv_ != nullptr) {
     const vision::FrontendCounts& c = frame.counts;
-    std::fprintf(csv_, "%.6f,%s,%s,%d,%d,%d,%d,%d", t_s,
+    std::fprintf(csv_, "%.6f,%s,%s,%d,%d,%d,%d,%d,%d,%d", t_s,
                  std::string(vision::to_string(frame.mode)).c_str(),
-                 std::string(vision::to_string(frame.status)).c_str(), c.previous, c.ransac_inliers,
-                 c.extracted, c.features, c.depth_associated);
+                 std::string(vision::to_string(frame.status)).c_str(), c.previous, c.tracked,
+                 c.ransac_inliers, c.crowded, c.extracted, c.features, c.depth_associated);
     for (const auto* s : q) std::fprintf(csv_, s->valid ? ",%.4f" : ",", s->confidence);
     for (const auto* s : q) std::fprintf(csv_, s->valid ? ",%.4f" : ",", s->gradient_metric);
     if (std::fprintf(csv_, "\n") < 0) write_failed_ = true;
