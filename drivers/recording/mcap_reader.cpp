@@ -131,6 +131,7 @@ bool McapReader::open_common(std::string& error) {
   unknown_records_.clear();
   summary_ = {};
   counters_ = {};
+  data_crc_decided_ = false;
   if (file_.size() < mcap::kMagicSize ||
       std::memcmp(file_.data(), mcap::kMagic.data(), mcap::kMagicSize) != 0) {
     error = "mcap " + path_ + ": not an MCAP file (bad or missing magic at offset 0)";
@@ -500,13 +501,20 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
 }
 
 bool McapReader::next(McapMessage& out) {
+  if (!data_crc_decided_) {
+    // Decided by the first reader that reads, not the first that opens: a reader opened only
+    // to list the channels must not take the check with it.
+    data_crc_decided_ = true;
+    verify_data_crc_ = options_.verify_crcs &&
+                       (options_.chunk_cache == nullptr || options_.chunk_cache->claim_data_crc());
+  }
   for (;;) {
     if (!chunk_records_.empty() && next_in_chunk(out)) return true;
     if (done_) return false;
     const std::uint64_t at = pos_;
     // What lies before this record (and before the data CRC's position) is read: out of
     // resident memory with it, in steps large enough to cost nothing.
-    const std::uint64_t done_with = options_.verify_crcs ? std::min(at, crc_pos_) : at;
+    const std::uint64_t done_with = verify_data_crc_ ? std::min(at, crc_pos_) : at;
     if (done_with >= released_ + kReleaseStepBytes) {
       mapped_.release(static_cast<std::size_t>(released_), static_cast<std::size_t>(done_with));
       released_ = done_with;
@@ -530,7 +538,7 @@ bool McapReader::next(McapMessage& out) {
     }
     const std::uint64_t record_end = at + mcap::kRecordPrefixSize + len;
     if (static_cast<Op>(op) == Op::kDataEnd) {
-      if (options_.verify_crcs) {
+      if (verify_data_crc_) {
         data_crc_.update(file_.subspan(static_cast<std::size_t>(crc_pos_),
                                        static_cast<std::size_t>(at - crc_pos_)));
         crc_pos_ = at;
@@ -548,7 +556,7 @@ bool McapReader::next(McapMessage& out) {
       counters_.bytes_scanned = record_end;
       return false;
     }
-    if (options_.verify_crcs && record_end - crc_pos_ > (8u << 20)) {
+    if (verify_data_crc_ && record_end - crc_pos_ > (8u << 20)) {
       // fold the data CRC forward in large steps, so it costs one pass over the file
       data_crc_.update(file_.subspan(static_cast<std::size_t>(crc_pos_),
                                      static_cast<std::size_t>(record_end - crc_pos_)));

@@ -102,7 +102,8 @@ struct McapReaderCounters {
 };
 
 struct McapReaderOptions {
-  /// check chunk CRCs, the data-section CRC and the summary CRC
+  /// check chunk CRCs, the data-section CRC and the summary CRC (the data-section CRC by one
+  /// reader of those sharing a chunk_cache: McapChunkCache::claim_data_crc)
   bool verify_crcs = true;
   /// skip whole chunks that end before this log time (only when the summary is usable, so no
   /// Channel record can be lost with them) [ns]
@@ -179,7 +180,9 @@ class McapReader {
   bool complete_ = false;
   std::string stop_reason_;
   Crc32 data_crc_;
-  std::uint64_t crc_pos_ = 0;  // bytes [0, crc_pos_) are in data_crc_
+  std::uint64_t crc_pos_ = 0;      // bytes [0, crc_pos_) are in data_crc_
+  bool verify_data_crc_ = true;    // this reader folds data_crc_
+  bool data_crc_decided_ = false;  // verify_data_crc_ is set (on the first next())
 
   // the chunk being walked
   std::span<const std::byte> chunk_records_;
