@@ -43,6 +43,26 @@ TEST(FrontendConfig, TheKltWindowAndPyramidAreTheConfiguredOnesAndDefaultToTheTr
   EXPECT_EQ(d.frontend.tracker.klt_pyramid_levels, vision::TrackerConfig{}.klt_pyramid_levels);
 }
 
+TEST(FrontendConfig, TheDepthNodeReachesTheFeaturesOnlyWhenAskedAndAtItsExtrinsic) {
+  // Off by default: a recording's depth stream is then not even replayed (run_daemon).
+  EXPECT_FALSE(config::default_config().depth_camera.feature_depth);
+  const fusion::CameraFrontEndConfig c = front_end_of(
+      "depth_camera:\n  feature_depth: true\n  fx: 400\n  cx: 320\n  feature_stride_px: 8\n"
+      "  feature_max_range_m: 3\n  feature_max_span_m: 0.2\n  feature_max_offset_s: 0.02\n"
+      "extrinsics:\n  T_cam_depth: [1, 0, 0, 0.015, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n");
+  EXPECT_TRUE(c.depth_image.enabled);
+  EXPECT_DOUBLE_EQ(c.depth_image.fx, 400);
+  EXPECT_DOUBLE_EQ(c.depth_image.cx, 320);
+  EXPECT_EQ(c.depth_image.stride_px, 8);
+  EXPECT_DOUBLE_EQ(c.depth_image.max_range_m, 3);
+  EXPECT_EQ(c.depth_image.max_offset.ns, 20'000'000);
+  EXPECT_DOUBLE_EQ(c.depth_image.T_cam_depth.translation().x(), 0.015);
+  // The depth search over the image's points: its span and range are the depth node's keys.
+  EXPECT_DOUBLE_EQ(c.frontend.stereo_depth.max_span_m, 0.2);
+  EXPECT_DOUBLE_EQ(c.frontend.stereo_depth.max_range_m, 3);
+  EXPECT_FALSE(front_end_of("").depth_image.enabled);
+}
+
 fusion::CameraFactorsConfig factors_of(const std::string& yaml) {
   const config::LoadResult loaded = config::load_config_text(yaml, "test.yaml");
   EXPECT_TRUE(loaded.ok()) << loaded.error_text();
