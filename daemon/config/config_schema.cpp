@@ -417,6 +417,11 @@ const Field kSchema[] = {
       "and it returns once g is at or above this (and the confidence above its threshold)"),
     F("estimator.camera_floor_translation_m", estimator.camera_floor_translation_m, "0.002", "m", 0,
       1, "", "1-sigma added to each camera factor's translation (features are not independent)"),
+    F("estimator.camera_strong_lidar_floor_translation_m",
+      estimator.camera_strong_lidar_floor_translation_m, "0.002", "m", 0, 1, "",
+      "the same where the lidar is strong (no degenerate scan within "
+      "camera_lidar_suspect_window_s): 0.03 keeps an open site within 1 mm of the lidar alone "
+      "but loses the speed the cameras measure before a tunnel (docs/estimator.md)"),
     F("estimator.camera_floor_rotation_deg", estimator.camera_floor_rotation_deg, "0.06", "deg", 0,
       10, "", "1-sigma added to each camera factor's rotation"),
     F("estimator.camera_keyframe_states", estimator.camera_keyframe_states, "5", "", 1, 49, "",

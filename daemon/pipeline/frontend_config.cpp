@@ -156,6 +156,7 @@ fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& con
   c.min_gradient = e.camera_min_gradient;
   c.rejoin_gradient = std::max(e.camera_rejoin_gradient, e.camera_min_gradient);
   c.floor_translation_m = e.camera_floor_translation_m;
+  c.strong_lidar_floor_translation_m = e.camera_strong_lidar_floor_translation_m;
   c.floor_rotation_rad = e.camera_floor_rotation_deg * M_PI / 180.0;
   c.keyframe_states = std::min(e.camera_keyframe_states, std::max(e.window_size - 1, 1));
   c.motion.still_flow_sigma = e.camera_still_flow_sigma;

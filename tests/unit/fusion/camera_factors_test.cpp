@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <random>
 
@@ -207,6 +208,35 @@ TEST(CameraFactors, WhereTheLidarIsWeakTheGateKeepsTheNearFeaturesAStaleSpeedMis
   const int strong = measure(false);
   const int weak = measure(true);
   EXPECT_GT(weak, strong + 20);
+}
+
+TEST(CameraFactors, WhereTheLidarIsStrongAFactorSaysNoMoreThanItsTranslationFloor) {
+  // Where the scans pin the motion to millimetres, a frame pair's errors would only add noise:
+  // its translation carries at least strong_lidar_floor_translation_m of sigma (30 mm here),
+  // where the lidar is weak only floor_translation_m (2 mm).
+  const FactorsWorld world;
+  const auto translation_information = [&](bool lidar_weak) {
+    CameraFactorsConfig c = factors_config();
+    c.strong_lidar_floor_translation_m = 0.03;
+    CameraFactors factors(c);
+    factors.set_lidar_weak(lidar_weak);
+    for (double t = 0.013; t < 0.45; t += 1.0 / 15) {
+      factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
+    }
+    estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+    fill(window, 0.3);
+    std::vector<estimator::RelativeMotion> motions;
+    factors.relative_motions(window, state_at(0.4), motions);
+    EXPECT_EQ(motions.size(), 1u);
+    if (motions.empty()) return 0.0;
+    const Eigen::Matrix3d info = motions[0].information.bottomRightCorner<3, 3>();
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(info).eigenvalues().maxCoeff();
+  };
+  const double strong = translation_information(false);
+  const double weak = translation_information(true);
+  EXPECT_LE(strong, 1.0 / (0.03 * 0.03) * 1.0001);
+  EXPECT_GT(strong, 0.5 / (0.03 * 0.03));  // the floor, not the features, bounds it
+  EXPECT_GT(weak, 10 * strong);
 }
 
 TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {

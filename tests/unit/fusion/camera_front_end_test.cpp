@@ -100,10 +100,19 @@ Image depth_image_of_wall(const Eigen::Isometry3d& T_cam_depth, HostTime stamp, 
   return image;
 }
 
+/// The buffers the rig's frames live in: declared before the front end, so they outlive the
+/// frames it still holds (a visible frame awaiting its partner, the newest depth images), as the
+/// pipeline's camera stages outlive its fusion core.
+struct RigPools {
+  PayloadPool visible{16, 640 * 480};
+  PayloadPool thermal{16, 640 * 512};
+  PayloadPool depth{8, 640 * 480 * 2};
+};
+
 /// Hands 3 s of a still rig to `front` in stamp order; returns the visible frames sent. Thermal
 /// frames stamped in [freeze_from_us, freeze_to_us) repeat the one before, byte for byte (the
 /// shutter closed for a flat-field correction).
-int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar,
+int run_still_rig(RigPools& pools, CameraFrontEnd& front, bool with_thermal, bool with_lidar,
                   std::int64_t freeze_from_us = -1, std::int64_t freeze_to_us = -1,
                   const DepthSources& depth = {}) {
   const auto vis_cam = scene::m2dgr_visible();
@@ -112,8 +121,8 @@ int run_still_rig(CameraFrontEnd& front, bool with_thermal, bool with_lidar,
       vis_cam, scene::pixel_rays(vis_cam), Eigen::Isometry3d::Identity(), kWallDepthM, 160, 40, 7);
   const cv::Mat thermal = scene::render_wall(th_cam, scene::pixel_rays(th_cam),
                                              scene::m2dgr_T_cam_thermal(), kWallDepthM, 120, 60, 7);
-  PayloadPool visible_pool(16, 640 * 480), thermal_pool(16, 640 * 512),
-      depth_pool(8, 640 * 480 * 2);
+  PayloadPool &visible_pool = pools.visible, &thermal_pool = pools.thermal,
+              &depth_pool = pools.depth;
   // Events in stamp order: IMU at 200 Hz, visible at 15 Hz (+3 ms), thermal at 25 Hz (+11 ms),
   // a lidar scan at 10 Hz.
   std::vector<lidar::ScanPoint> wall;
@@ -174,10 +183,11 @@ TEST(CameraFrontEnd, FusedModeTracksEveryPairedFrameAndTheOtherModesCompareOnThe
   Rig rig;
   rig.config.frontend.mode = vision::FrontendMode::kFused;
   rig.config.compare_modes = {vision::FrontendMode::kVisible, vision::FrontendMode::kThermal};
+  RigPools pools;
   CameraFrontEnd front(rig.config);
   CountingObserver observer;
   front.set_observer(&observer);
-  const int sent = run_still_rig(front, /*with_thermal=*/true, /*with_lidar=*/true);
+  const int sent = run_still_rig(pools, front, /*with_thermal=*/true, /*with_lidar=*/true);
 
   const auto& pairing = front.pairing();
   ASSERT_GT(pairing.paired, 35u);
@@ -215,8 +225,9 @@ TEST(CameraFrontEnd, WithoutThermalFramesFusedEventsAreUnusableAndVisibleModeRun
   Rig rig;
   rig.config.frontend.mode = vision::FrontendMode::kFused;
   rig.config.compare_modes = {vision::FrontendMode::kVisible};
+  RigPools pools;
   CameraFrontEnd front(rig.config);
-  const int sent = run_still_rig(front, /*with_thermal=*/false, /*with_lidar=*/false);
+  const int sent = run_still_rig(pools, front, /*with_thermal=*/false, /*with_lidar=*/false);
   const CameraFigures& fused = front.figures();
   EXPECT_EQ(fused.frames, 0u);
   EXPECT_GE(fused.frames_unusable + 2, static_cast<std::uint64_t>(sent));
@@ -229,10 +240,11 @@ TEST(CameraFrontEnd, WithoutThermalFramesFusedEventsAreUnusableAndVisibleModeRun
 TEST(CameraFrontEnd, FrozenThermalFramesAreLeftOut) {
   Rig rig;
   rig.config.frontend.mode = vision::FrontendMode::kThermal;
+  RigPools pools;
   CameraFrontEnd front(rig.config);
   // Half a second of repeated thermal frames: the 8 events of the visible camera's 15 Hz in it
   // pair with thermal frames, the first with the new one, the 7 after it with repeats.
-  run_still_rig(front, /*with_thermal=*/true, /*with_lidar=*/true, 1'000'000, 1'500'000);
+  run_still_rig(pools, front, /*with_thermal=*/true, /*with_lidar=*/true, 1'000'000, 1'500'000);
   const CameraFigures& thermal = front.figures();
   EXPECT_EQ(thermal.thermal_frozen, 7u);
   EXPECT_EQ(thermal.frames_unusable, 7u);
@@ -251,13 +263,14 @@ TEST(CameraFrontEnd, WhereTheLidarGivesNoDepthTheDepthImageDoesAtItsExtrinsic) {
     rig.config.depth_image.T_cam_depth = T_cam_depth;
     rig.config.depth_image.max_range_m = 8;  // the wall is 6 m away
     rig.config.depth_image.max_offset = max_offset;
+    RigPools pools;
     CameraFrontEnd front(rig.config);
     front.set_observer(&observer);
     DepthSources depth;
     depth.lidar_left_half_only = true;
     depth.T_cam_depth = depth_camera;
     depth.offset_us = offset_us;
-    run_still_rig(front, /*with_thermal=*/false, /*with_lidar=*/true, -1, -1, depth);
+    run_still_rig(pools, front, /*with_thermal=*/false, /*with_lidar=*/true, -1, -1, depth);
     return front.figures();
   };
   CountingObserver lidar_only;
