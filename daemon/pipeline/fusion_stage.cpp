@@ -166,6 +166,14 @@ void FusionStage::hand_imu(const ImuItem& item) {
   tag_new_states();
 }
 
+void FusionStage::hand_image(Lane<ImageItem>& lane, CameraStream stream) {
+  ImageItem item = lane.take();
+  took(fusion_stream_index(stream), item);
+  core_->add_image(stream, std::move(item.image), produced_);
+  tag_new_states();
+  counters_.frames_fused[static_cast<std::size_t>(stream)].fetch_add(1, std::memory_order_relaxed);
+}
+
 void FusionStage::note_imu_switch() {
   counters_.imu_on_backup.store(failover_.in_use() == ImuInUse::kBackup, std::memory_order_relaxed);
   counters_.imu_failovers.store(failover_.failovers(), std::memory_order_relaxed);
@@ -264,30 +272,15 @@ void FusionStage::run() {
           for (ScanObserver* observer : scan_observers_) observer->after_scan(*core_);
           break;
         }
-        case Next::kVisible: {
-          ImageItem item = visible.take();
-          took(2, item);
-          core_->add_image(CameraStream::kVisible, std::move(item.image), produced_);
-          tag_new_states();
-          counters_.frames_fused[0].fetch_add(1, std::memory_order_relaxed);
+        case Next::kVisible:
+          hand_image(visible, CameraStream::kVisible);
           break;
-        }
-        case Next::kThermal: {
-          ImageItem item = thermal.take();
-          took(3, item);
-          core_->add_image(CameraStream::kThermal, std::move(item.image), produced_);
-          tag_new_states();
-          counters_.frames_fused[1].fetch_add(1, std::memory_order_relaxed);
+        case Next::kThermal:
+          hand_image(thermal, CameraStream::kThermal);
           break;
-        }
-        case Next::kDepth: {
-          ImageItem item = depth.take();
-          took(5, item);
-          core_->add_image(CameraStream::kDepth, std::move(item.image), produced_);
-          tag_new_states();
-          counters_.frames_fused[2].fetch_add(1, std::memory_order_relaxed);
+        case Next::kDepth:
+          hand_image(depth, CameraStream::kDepth);
           break;
-        }
         case Next::kNone:
           break;
       }

@@ -110,6 +110,8 @@ class FusionStage {
   bool dispatch_ready();
   /// Hands one IMU sample (the A9's or, standing in, the D435i's) to the odometry and the core.
   void hand_imu(const ImuItem& item);
+  /// Hands the frame at the head of `lane`, of camera `stream`, to the core and counts it.
+  void hand_image(Lane<ImageItem>& lane, CameraStream stream);
   /// Logs and counts a hand-over between the A9 and the D435i's IMU.
   void note_imu_switch();
   /// Routes the states the core produced: to the publisher and, as anchors, to the odometry.
