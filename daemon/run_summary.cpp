@@ -23,6 +23,11 @@ double yaw_deg(const Eigen::Quaterniond& q) {
   return std::atan2(x.y(), x.x()) * 180.0 / M_PI;
 }
 
+/// `part` as a share of `whole` [%]; 0 when there is no whole.
+double percent(std::uint64_t part, std::uint64_t whole) {
+  return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+}
+
 }  // namespace
 
 namespace {
@@ -156,7 +161,7 @@ bool print_run_summary(const RunSummary& r) {
           "  replay reading      %llu compressed chunks decompressed, %llu reads served from "
           "another stream's (%.1f %%)\n",
           static_cast<unsigned long long>(c.misses), static_cast<unsigned long long>(c.hits),
-          reads > 0 ? 100.0 * static_cast<double>(c.hits) / static_cast<double>(reads) : 0.0);
+          percent(c.hits, reads));
     }
     if (r.options.replay.loop) {
       std::printf(
@@ -201,9 +206,6 @@ bool print_run_summary(const RunSummary& r) {
   if (!st.estimator.camera.mode.empty()) {
     const CameraFigures& c = st.estimator.camera;
     const double frames = static_cast<double>(std::max<std::uint64_t>(c.frames, 1));
-    const auto percent = [](std::uint64_t part, std::uint64_t whole) {
-      return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
-    };
     // The D435i's depth node, where a recording or the rig has one.
     char stereo[128] = "";
     if (c.depth_images > 0) {
