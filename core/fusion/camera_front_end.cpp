@@ -213,14 +213,12 @@ void CameraFrontEnd::run_event(Event& e, const Eigen::Vector3d& gyro_bias_radps)
 
 bool CameraFrontEnd::depth_image_points(HostTime stamp, const Eigen::Isometry3d& T_map_cam) {
   const DepthImageConfig& c = config_.depth_image;
+  const auto offset_ns = [&](const Image& image) { return std::abs((image.stamp - stamp).ns); };
   const Image* nearest = nullptr;
   for (const Image& image : depth_images_) {
-    if (nearest == nullptr ||
-        std::abs((image.stamp - stamp).ns) < std::abs((nearest->stamp - stamp).ns)) {
-      nearest = &image;
-    }
+    if (nearest == nullptr || offset_ns(image) < offset_ns(*nearest)) nearest = &image;
   }
-  if (nearest == nullptr || std::abs((nearest->stamp - stamp).ns) > c.max_offset.ns) return false;
+  if (nearest == nullptr || offset_ns(*nearest) > c.max_offset.ns) return false;
   // The depth image's camera at its own stamp, seen from the camera at the frame's: the robot
   // moves up to half a depth frame period between them (2-3 cm at walking speed).
   const std::optional<Pose> T_depth_stamp = poses_.at(nearest->stamp);

@@ -94,16 +94,25 @@ void fill(estimator::SlidingWindow& w, double t_last) {
   for (double t = 0.1; t <= t_last + 1e-9; t += 0.1) w.add(state_at(t), pre, std::nullopt);
 }
 
-TEST(CameraFactors, MeasuresTheMotionBetweenStatesFromFramesOffTheirStamps) {
-  const FactorsWorld world;
-  CameraFactors factors(factors_config());
-  // Frames at 15 Hz with a phase: none falls on a state's stamp.
-  for (double t = 0.013; t < 0.5; t += 1.0 / 15)
+/// Visible frames at 15 Hz from 13 ms (none on a state's stamp) up to `frames_until_s`, a window
+/// of states up to 0.3 s, and the motions `factors` give a new state at 0.4 s.
+std::vector<estimator::RelativeMotion> one_motion(CameraFactors& factors, const FactorsWorld& world,
+                                                  double frames_until_s) {
+  for (double t = 0.013; t < frames_until_s; t += 1.0 / 15) {
     factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
+  }
   estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
   fill(window, 0.3);
   std::vector<estimator::RelativeMotion> motions;
   factors.relative_motions(window, state_at(0.4), motions);
+  return motions;
+}
+
+TEST(CameraFactors, MeasuresTheMotionBetweenStatesFromFramesOffTheirStamps) {
+  const FactorsWorld world;
+  CameraFactors factors(factors_config());
+  // Frames at 15 Hz with a phase: none falls on a state's stamp.
+  const std::vector<estimator::RelativeMotion> motions = one_motion(factors, world, 0.5);
   ASSERT_EQ(motions.size(), 1u);
   EXPECT_EQ(motions[0].kind, estimator::FactorKind::kVisible);
   const Eigen::Isometry3d expected = truth(0.3).inverse() * truth(0.4);
@@ -220,13 +229,7 @@ TEST(CameraFactors, WhereTheLidarIsStrongAFactorSaysNoMoreThanItsTranslationFloo
     c.strong_lidar_floor_translation_m = 0.03;
     CameraFactors factors(c);
     factors.set_lidar_weak(lidar_weak);
-    for (double t = 0.013; t < 0.45; t += 1.0 / 15) {
-      factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
-    }
-    estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
-    fill(window, 0.3);
-    std::vector<estimator::RelativeMotion> motions;
-    factors.relative_motions(window, state_at(0.4), motions);
+    const std::vector<estimator::RelativeMotion> motions = one_motion(factors, world, 0.45);
     EXPECT_EQ(motions.size(), 1u);
     if (motions.empty()) return 0.0;
     const Eigen::Matrix3d info = motions[0].information.bottomRightCorner<3, 3>();
