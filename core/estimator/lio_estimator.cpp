@@ -252,6 +252,7 @@ void LioEstimator::reinitialise(const imu::ImuState& at, const Eigen::Vector3d& 
   // Biases back to what the start-up alignment found: the window's may be what diverged.
   s.bias.gyro_radps = aligned_ ? aligned_->gyro_bias_radps : Eigen::Vector3d::Zero();
   s.bias.accel_mps2.setZero();
+  strong_since_.reset();  // the speed and biases are to be found again
   Eigen::Matrix<double, 15, 1> sigma;
   sigma << Eigen::Vector3d::Constant(0.05), Eigen::Vector3d::Constant(0.02),
       Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(0.02),
@@ -384,6 +385,9 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
   // is right, and the cameras' motion, scaled by depths with their own errors, is not better.
   lidar_suspect_ = last_degenerate_stamp_ &&
                    (t - *last_degenerate_stamp_).seconds() <= config_.aided_suspect_window_s;
+  if (!strong_since_ || !match.ok || match.degenerate_directions > 0) strong_since_ = t;
+  lidar_settled_ =
+      !lidar_suspect_ && (t - *strong_since_).seconds() >= config_.aided_settled_after_s;
 
   begin(LioStep::kWindow);
   if (window_.empty()) {
@@ -455,6 +459,7 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   motions_.clear();
   if (aiding_ != nullptr) {
     aiding_->set_lidar_weak(lidar_suspect_);
+    aiding_->set_lidar_settled(lidar_settled_);
     aiding_->relative_motions(window_, predicted, motions_);
   }
   if (lidar_factor && !motions_.empty() && lidar_suspect_) reconcile(*lidar_factor);

@@ -71,6 +71,10 @@ struct LioConfig {
   double aided_consistency_sigma = 3.0;
   /// reconcile() only within this time after a scan with a degenerate direction [s]
   double aided_suspect_window_s = 5.0;
+  /// The lidar is settled once every scan for this long has pinned every direction (none
+  /// degenerate or rejected, the window not restarted): the aiding then weighs itself as beside a
+  /// lidar that has fixed the speed and biases (WindowAiding::set_lidar_settled) [s]
+  double aided_settled_after_s = 0.0;
   /// seed 001's adaptive pose selection of each state's initial value (pose_selection.hpp); off:
   /// the IMU prediction
   bool pose_selection = true;
@@ -196,8 +200,10 @@ class LioEstimator final : public FusionCore {
   std::vector<RelativeMotion> motions_;            // this scan's, from the aiding
   std::vector<std::uint64_t> from_ids_;            // the window ids their motions start from
   std::optional<HostTime> last_degenerate_stamp_;  // of the last scan with a degenerate direction
-  bool lidar_suspect_ = false;     // one was found within aided_suspect_window_s (reconcile())
-  bool aided_degeneracy_ = false;  // the lidar's degeneracy is set for an active aiding
+  bool lidar_suspect_ = false;  // one was found within aided_suspect_window_s (reconcile())
+  std::optional<HostTime> strong_since_;  // every scan since pinned every direction
+  bool lidar_settled_ = false;            // for aided_settled_after_s
+  bool aided_degeneracy_ = false;         // the lidar's degeneracy is set for an active aiding
   void begin(LioStep s) {
     if (probe_ != nullptr) probe_->begin(s);
   }

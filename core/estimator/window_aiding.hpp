@@ -42,6 +42,9 @@ class WindowAiding {
   /// Told before each relative_motions whether the lidar has recently been unable to pin a
   /// direction (a scan with a degenerate direction within `aided_suspect_window_s`).
   virtual void set_lidar_weak(bool weak) { (void)weak; }
+  /// Told with set_lidar_weak whether the lidar has pinned every direction for
+  /// `aided_settled_after_s` (and so has fixed the speed and biases by itself).
+  virtual void set_lidar_settled(bool settled) { (void)settled; }
   /// Whether it expects to add motions for the next state (e.g. a camera whose images are good
   /// enough): the lidar then leaves its weakly constrained directions to it.
   virtual bool active() const = 0;

@@ -66,6 +66,11 @@ void CameraAidedCore::set_lidar_weak(bool weak) {
   factors_->set_lidar_weak(weak);
 }
 
+void CameraAidedCore::set_lidar_settled(bool settled) {
+  sync();
+  factors_->set_lidar_settled(settled);
+}
+
 void CameraAidedCore::relative_motions(const estimator::SlidingWindow& window,
                                        const imu::ImuState& next,
                                        std::vector<estimator::RelativeMotion>& out) {

@@ -71,6 +71,7 @@ class CameraAidedCore final : public FusionCore,
   void relative_motions(const estimator::SlidingWindow& window, const imu::ImuState& next,
                         std::vector<estimator::RelativeMotion>& out) override;
   void set_lidar_weak(bool weak) override;
+  void set_lidar_settled(bool settled) override;
   bool active() const override { return active_; }
   std::uint8_t add_factors(estimator::SlidingWindow& window) override;
   void after_solve(const estimator::SlidingWindow& window) override;

@@ -173,8 +173,8 @@ std::optional<estimator::RelativeMotion> CameraFactors::measure(
   const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
   const double omega = std::max(a->omega, b->omega) * residual_scale_[stream];
   Mat6 covariance = omega * A * m.covariance * A.transpose();
-  const double floor_m =
-      lidar_weak_ ? config_.floor_translation_m : config_.strong_lidar_floor_translation_m;
+  const double floor_m = !lidar_weak_ && lidar_settled_ ? config_.strong_lidar_floor_translation_m
+                                                        : config_.floor_translation_m;
   covariance.diagonal().tail<3>().array() += floor_m * floor_m;
   if (config_.translation_only) {
     // The rotation was the window's: only the translation is the cameras' information.

@@ -151,6 +151,7 @@ class CameraFactors final : public estimator::WindowAiding {
   std::uint8_t add_factors(estimator::SlidingWindow& window) override;
   void after_solve(const estimator::SlidingWindow& window) override;
   void set_lidar_weak(bool weak) override { lidar_weak_ = weak; }
+  void set_lidar_settled(bool settled) override { lidar_settled_ = settled; }
   /// A configured stream's gate is open.
   bool active() const override;
 
@@ -190,6 +191,7 @@ class CameraFactors final : public estimator::WindowAiding {
   std::array<double, 3> residual_scale_{1.0, 1.0, 1.0};    // per stream, see residual_scaling
   std::array<std::optional<HostTime>, 3> keyframe_stamp_;  // per stream, see keyframe_states
   bool lidar_weak_ = true;         // keyframes only then (see keyframe_states)
+  bool lidar_settled_ = true;      // strong_lidar_floor_translation_m only then
   std::vector<double> residuals_;  // scratch
 };
 

@@ -221,14 +221,16 @@ TEST(CameraFactors, WhereTheLidarIsWeakTheGateKeepsTheNearFeaturesAStaleSpeedMis
 
 TEST(CameraFactors, WhereTheLidarIsStrongAFactorSaysNoMoreThanItsTranslationFloor) {
   // Where the scans pin the motion to millimetres, a frame pair's errors would only add noise:
-  // its translation carries at least strong_lidar_floor_translation_m of sigma (30 mm here),
-  // where the lidar is weak only floor_translation_m (2 mm).
+  // its translation carries at least strong_lidar_floor_translation_m of sigma (30 mm here) once
+  // the lidar has settled, where the lidar is weak or not yet settled only floor_translation_m
+  // (2 mm).
   const FactorsWorld world;
-  const auto translation_information = [&](bool lidar_weak) {
+  const auto translation_information = [&](bool lidar_weak, bool lidar_settled = true) {
     CameraFactorsConfig c = factors_config();
     c.strong_lidar_floor_translation_m = 0.03;
     CameraFactors factors(c);
     factors.set_lidar_weak(lidar_weak);
+    factors.set_lidar_settled(lidar_settled);
     const std::vector<estimator::RelativeMotion> motions = one_motion(factors, world, 0.45);
     EXPECT_EQ(motions.size(), 1u);
     if (motions.empty()) return 0.0;
@@ -237,9 +239,11 @@ TEST(CameraFactors, WhereTheLidarIsStrongAFactorSaysNoMoreThanItsTranslationFloo
   };
   const double strong = translation_information(false);
   const double weak = translation_information(true);
+  const double unsettled = translation_information(false, false);
   EXPECT_LE(strong, 1.0 / (0.03 * 0.03) * 1.0001);
   EXPECT_GT(strong, 0.5 / (0.03 * 0.03));  // the floor, not the features, bounds it
   EXPECT_GT(weak, 10 * strong);
+  EXPECT_GT(unsettled, 10 * strong);
 }
 
 TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {

@@ -5,6 +5,7 @@
 
 #include <Eigen/SVD>
 #include <cstdio>
+#include <optional>
 
 #include "core/estimator/lio_estimator.hpp"
 #include "core/math/so3.hpp"
@@ -60,11 +61,13 @@ void ate(const std::vector<Eigen::Vector3d>& est, const std::vector<Eigen::Vecto
   rmse = std::sqrt(sum / static_cast<double>(est.size()));
 }
 
-/// Feeds the run from `start_s` on, with `corrupt` applied to every IMU sample.
+/// Feeds the run from `start_s` on, with `corrupt` applied to every IMU sample (and `aiding`,
+/// if any, beside the window).
 template <class Corrupt>
 Outcome run_lio(const sim::LidarImuRun& run, const LioConfig& config, double start_s,
-                Corrupt corrupt) {
+                Corrupt corrupt, WindowAiding* aiding = nullptr) {
   LioEstimator lio(config);
+  lio.set_aiding(aiding);
   PayloadPool pool(4, drivers::velodyne::max_points_per_scan(600) * sizeof(LidarPoint));
   std::vector<NavState> states;
   const HostTime start = run.imu.front().stamp + Duration::from_seconds(start_s);
@@ -168,6 +171,61 @@ TEST(LioEstimator, DivergenceIsDetectedAndTheEstimateRecovers) {
   double rmse = 0, max_error = 0;
   ate(est, gt, rmse, max_error);
   EXPECT_LT(rmse, 0.15);
+}
+
+/// An aiding that measures nothing and writes down what the estimator told it before each state.
+class ListeningAiding final : public WindowAiding {
+ public:
+  struct Told {
+    HostTime stamp;
+    bool weak = false;
+    bool settled = false;
+  };
+  void relative_motions(const SlidingWindow&, const imu::ImuState& next,
+                        std::vector<RelativeMotion>&) override {
+    told.push_back({next.stamp, weak_, settled_});
+  }
+  void set_lidar_weak(bool weak) override { weak_ = weak; }
+  void set_lidar_settled(bool settled) override { settled_ = settled; }
+  bool active() const override { return false; }
+  std::vector<Told> told;
+
+ private:
+  bool weak_ = true;
+  bool settled_ = false;
+};
+
+TEST(LioEstimator, TheLidarIsSettledOnceItHasPinnedEveryDirectionForTheConfiguredTime) {
+  // A street the lidar pins throughout: settled from aided_settled_after_s after the first scan
+  // on, and again that long after a broken accelerometer restarted the window.
+  const sim::LidarImuRun& run = test::simulated("street_night", 30.0, 4);
+  const HostTime t0 = run.imu.front().stamp;
+  LioConfig config = lio_config(run.rig);
+  config.aided_settled_after_s = 3.0;
+  ListeningAiding aiding;
+  const Outcome o = run_lio(
+      run, config, 0.0,
+      [&](ImuSample& s) {
+        const double t = (s.stamp - t0).seconds();
+        if (t > 15.0 && t < 16.5) s.specific_force_mps2.x() = 80.0;
+      },
+      &aiding);
+  ASSERT_EQ(o.figures.scans_degenerate, 0u);
+  ASSERT_GE(o.figures.reinitialisations, 1u);
+  ASSERT_GT(aiding.told.size(), 200u);
+  const HostTime first = aiding.told.front().stamp;
+  std::optional<HostTime> first_settled, unsettled_after_fault, settled_again;
+  for (const ListeningAiding::Told& t : aiding.told) {
+    EXPECT_FALSE(t.weak);
+    if (t.settled && !first_settled) first_settled = t.stamp;
+    if (first_settled && !t.settled && !unsettled_after_fault) unsettled_after_fault = t.stamp;
+    if (unsettled_after_fault && t.settled && !settled_again) settled_again = t.stamp;
+  }
+  ASSERT_TRUE(first_settled && unsettled_after_fault && settled_again);
+  // The first state told is one scan after the first scan (which only starts the window).
+  EXPECT_NEAR((*first_settled - first).seconds(), 3.0 - 0.1, 0.15);
+  EXPECT_GT((*unsettled_after_fault - t0).seconds(), 15.0);
+  EXPECT_GE((*settled_again - *unsettled_after_fault).seconds(), 2.8);
 }
 
 }  // namespace

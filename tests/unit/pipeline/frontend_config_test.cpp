@@ -9,6 +9,7 @@
 
 #include "core/vision/feature_tracker.hpp"
 #include "daemon/config/config_loader.hpp"
+#include "daemon/pipeline/estimator_config.hpp"
 
 namespace posed::pipeline {
 namespace {
@@ -96,6 +97,14 @@ TEST(FrontendConfig, TheCameraCouplingAndTheLandmarksThresholdsAreTheConfiguredO
   EXPECT_DOUBLE_EQ(factors_of("estimator:\n  camera_strong_lidar_floor_translation_m: 0.01\n")
                        .strong_lidar_floor_translation_m,
                    0.01);
+  // ... which applies once the lidar has pinned everything for camera_strong_lidar_after_s.
+  const auto settled_after_s = [](const std::string& yaml) {
+    const config::LoadResult loaded = config::load_config_text(yaml, "test.yaml");
+    EXPECT_TRUE(loaded.ok()) << loaded.error_text();
+    return lio_config(loaded.config).aided_settled_after_s;
+  };
+  EXPECT_DOUBLE_EQ(settled_after_s(""), 0);
+  EXPECT_DOUBLE_EQ(settled_after_s("estimator:\n  camera_strong_lidar_after_s: 12\n"), 12);
   EXPECT_EQ(factors_of("estimator:\n  camera_coupling: loose+landmarks\n").coupling,
             fusion::CameraCoupling::kBoth);
   // A coupling the schema does not know stops start-up, naming the key.
