@@ -107,13 +107,14 @@ struct CameraFactorsConfig {
   /// independent (tracking errors, depth association, time offsets) [rad], [m]
   double floor_rotation_rad = 0.001;
   double floor_translation_m = 0.002;
-  /// the translation floor where the lidar is strong (no degenerate scan within
-  /// lidar_suspect_window): there a scan pins the motion to millimetres and a frame pair's
-  /// errors only add noise. 30 mm brings the mine, room and street_night within 1 mm of the
-  /// lidar alone (2 mm leaves them up to 8 mm worse) but costs the tunnel the speed the cameras
-  /// measure before it (seed 4, 30 s: 0.37 m against 0.09 m), so the default stays 2 mm
-  /// (docs/estimator.md) [m]
-  double strong_lidar_floor_translation_m = 0.002;
+  /// the translation floor where the lidar is strong and settled (set_lidar_weak(false),
+  /// set_lidar_settled(true): no degenerate or rejected scan for aided_settled_after_s): there a
+  /// scan pins the motion to millimetres and a frame pair's errors only add noise. 30 mm brings
+  /// the mine, room and street_night within about a millimetre of the lidar alone (2 mm left
+  /// them up to 8 mm worse); applied from the first scan on, it cost the tunnel the speed the
+  /// cameras measure before it (seed 4, 30 s: 0.37 m against 0.09 m), which the settling time
+  /// keeps (docs/estimator.md) [m]
+  double strong_lidar_floor_translation_m = 0.03;
   /// Huber threshold of the factors in the window [sigma]
   double huber_sigma = 3.0;
   /// scale each stream's covariance by how far its factors sit from the solution compared with
@@ -191,7 +192,7 @@ class CameraFactors final : public estimator::WindowAiding {
   std::array<double, 3> residual_scale_{1.0, 1.0, 1.0};    // per stream, see residual_scaling
   std::array<std::optional<HostTime>, 3> keyframe_stamp_;  // per stream, see keyframe_states
   bool lidar_weak_ = true;         // keyframes only then (see keyframe_states)
-  bool lidar_settled_ = true;      // strong_lidar_floor_translation_m only then
+  bool lidar_settled_ = false;     // strong_lidar_floor_translation_m only then
   std::vector<double> residuals_;  // scratch
 };
 

@@ -90,10 +90,9 @@ TEST(FrontendConfig, TheCameraCouplingAndTheLandmarksThresholdsAreTheConfiguredO
       factors_of("estimator:\n  camera_guess_gate_px: 2.5\n  camera_weak_lidar_guess_gate_px: 9\n");
   EXPECT_DOUBLE_EQ(g.guess_gate_px, 2.5);
   EXPECT_DOUBLE_EQ(g.weak_lidar_guess_gate_px, 9);
-  // The translation floor: 2 mm by default wherever the lidar is, and its own key where the
-  // lidar pins the motion.
+  // The translation floor: 2 mm by default, and 30 mm where the lidar pins the motion.
   EXPECT_DOUBLE_EQ(factors_of("").floor_translation_m, 0.002);
-  EXPECT_DOUBLE_EQ(factors_of("").strong_lidar_floor_translation_m, 0.002);
+  EXPECT_DOUBLE_EQ(factors_of("").strong_lidar_floor_translation_m, 0.03);
   EXPECT_DOUBLE_EQ(factors_of("estimator:\n  camera_strong_lidar_floor_translation_m: 0.01\n")
                        .strong_lidar_floor_translation_m,
                    0.01);
@@ -103,7 +102,7 @@ TEST(FrontendConfig, TheCameraCouplingAndTheLandmarksThresholdsAreTheConfiguredO
     EXPECT_TRUE(loaded.ok()) << loaded.error_text();
     return lio_config(loaded.config).aided_settled_after_s;
   };
-  EXPECT_DOUBLE_EQ(settled_after_s(""), 0);
+  EXPECT_DOUBLE_EQ(settled_after_s(""), 5);
   EXPECT_DOUBLE_EQ(settled_after_s("estimator:\n  camera_strong_lidar_after_s: 12\n"), 12);
   EXPECT_EQ(factors_of("estimator:\n  camera_coupling: loose+landmarks\n").coupling,
             fusion::CameraCoupling::kBoth);
