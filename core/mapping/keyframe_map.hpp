@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/mapping/compact_cloud.hpp"
 #include "core/mapping/pose_graph.hpp"
 #include "core/mapping/scan_context.hpp"
 
@@ -20,8 +21,8 @@ struct MapKeyframe {
   /// poses and TUM files are stamped) [ns]
   std::int64_t stamp_ns = 0;
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
-  std::vector<Eigen::Vector3f> points_base;  ///< thinned to KeyframeMap::voxel_m [m]
-  ScanContext context;                       ///< of the full scan, levelled
+  CompactCloud points_base;  ///< thinned to KeyframeMap::voxel_m [m]
+  ScanContext context;       ///< of the full scan, levelled
 };
 
 struct KeyframeMap {

@@ -39,9 +39,10 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
   kf.stamp = stamp;
   kf.T_odom_base = T_odom_base;
   kf.R_level_base = described.R_level_base;
-  kf.points_base = std::move(described.points_base);
+  kf.points_base = CompactCloud(described.points_base);
   kf.context = std::move(described.context);
   figures_.stored_points += kf.points_base.size();
+  figures_.stored_bytes += kf.points_base.bytes();
 
   // A new node where the current correction puts it, tied to the one before by the odometry.
   const std::size_t index = graph_.add_node(T_map_odom_ * T_odom_base);
@@ -145,8 +146,8 @@ void LoopCloser::try_loop(std::size_t query) {
   const std::vector<Eigen::Vector3f> target = submap(candidate->index, eligible - 1);
   const auto started = std::chrono::steady_clock::now();
   const RegistrationResult reg =
-      register_clouds(keyframes_[query].points_base, target, candidate->T_candidate_query_guess,
-                      config_.registration);
+      register_clouds(keyframes_[query].points_base.points(), target,
+                      candidate->T_candidate_query_guess, config_.registration);
   figures_.registration_time_s +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!reg.accepted()) {

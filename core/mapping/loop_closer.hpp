@@ -95,6 +95,7 @@ struct LoopClosureFigures {
   double last_optimisation_s = 0;           ///< [s]
   double registration_time_s = 0;           ///< summed [s]
   std::size_t stored_points = 0;            ///< keyframe cloud points held [1]
+  std::size_t stored_bytes = 0;             ///< what those points take [B]
 };
 
 class LoopCloser {
@@ -120,9 +121,7 @@ class LoopCloser {
   Eigen::Isometry3d T_map_keyframe(std::size_t i) const { return graph_.node(i); }
   std::size_t keyframe_count() const { return keyframes_.size(); }
   HostTime keyframe_stamp(std::size_t i) const { return keyframes_.at(i).stamp; }
-  std::span<const Eigen::Vector3f> keyframe_points(std::size_t i) const {
-    return keyframes_.at(i).points_base;
-  }
+  const CompactCloud& keyframe_points(std::size_t i) const { return keyframes_.at(i).points_base; }
 
   const LoopClosureFigures& figures() const { return figures_; }
   const std::vector<LoopRecord>& loops() const { return loops_; }
@@ -136,7 +135,7 @@ class LoopCloser {
     HostTime stamp;
     Eigen::Isometry3d T_odom_base;
     Eigen::Matrix3d R_level_base;  ///< removes roll and pitch: the Scan Context's frame
-    std::vector<Eigen::Vector3f> points_base;
+    CompactCloud points_base;
     ScanContext context;
   };
   struct Candidate {

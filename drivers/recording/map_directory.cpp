@@ -428,8 +428,21 @@ bool read_cloud(const std::string& path, mapping::KeyframeMap& map, std::string&
                        std::to_string(map.keyframes.size()));
         return false;
       }
-      map.keyframes[p.keyframe].points_base.push_back(T_base_map[p.keyframe] *
-                                                      Eigen::Vector3f(p.x, p.y, p.z));
+      const Eigen::Vector3f p_base = T_base_map[p.keyframe] * Eigen::Vector3f(p.x, p.y, p.z);
+      if (!mapping::CompactCloud::fits(p_base)) {
+        char where[160];
+        std::snprintf(where, sizeof where, "(%.1f, %.1f, %.1f) m from it", p_base.x(), p_base.y(),
+                      p_base.z());
+        error = at(path, 0,
+                   "point " + std::to_string(first + k) + " (byte " +
+                       std::to_string(offset + static_cast<long long>(k * sizeof(Point))) +
+                       ") of keyframe " + std::to_string(p.keyframe) + " is " + where +
+                       ": a keyframe keeps its points within " +
+                       std::to_string(static_cast<int>(mapping::CompactCloud::kReachM)) +
+                       " m of itself on every axis");
+        return false;
+      }
+      map.keyframes[p.keyframe].points_base.push_back(p_base);
     }
     if (got < n) {
       error = at(path, 0,

@@ -48,7 +48,9 @@ TEST(PclReadsMap, PclsReaderOpensMapPcdWithItsFieldsAndPoints) {
   ASSERT_EQ(xyz.size(), 2 * room.size());
   for (std::size_t k = 0; k < room.size(); k += 97) {
     for (std::size_t i = 0; i < 2; ++i) {
-      const Eigen::Vector3f expected = map.keyframes[i].T_map_base.cast<float>() * room[k];
+      // The point as the keyframe keeps it (to 4 mm), in the map frame.
+      const Eigen::Vector3f expected =
+          map.keyframes[i].T_map_base.cast<float>() * map.keyframes[i].points_base[k];
       const pcl::PointXYZ& p = xyz[i * room.size() + k];
       EXPECT_LT((Eigen::Vector3f(p.x, p.y, p.z) - expected).norm(), 1e-5f) << i << "/" << k;
     }
