@@ -21,13 +21,6 @@ SlidingWindowConfig window_config(const LioConfig& c) {
   return w;
 }
 
-Eigen::Isometry3d pose_of(const imu::ImuState& s) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = s.q_map_imu.toRotationMatrix();
-  T.translation() = s.p_map_imu_m;
-  return T;
-}
-
 /// The covariance of an information matrix that may be singular (a direction nothing measured
 /// gets a variance of 1e9).
 Eigen::Matrix<double, 6, 6> covariance_of(const Eigen::Matrix<double, 6, 6>& information) {
@@ -176,7 +169,7 @@ LioEstimator::Integrated LioEstimator::integrate(const imu::ImuState& from, Host
   const auto record = [&] {
     if (motion == nullptr) return;
     const imu::ImuState s = out.pre.predict(from, config_.gravity_mps2);
-    lidar_poses.emplace_back(out.pre.end(), pose_of(s) * config_.T_imu_lidar);
+    lidar_poses.emplace_back(out.pre.end(), imu::T_map_imu(s) * config_.T_imu_lidar);
   };
   // Start exactly at `from`: interpolate between the bracket below it and the next sample.
   std::size_t i = 0;
@@ -334,7 +327,7 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
   }
   imu::ImuState predicted = integrated.pre.predict(from, config_.gravity_mps2);
   predicted.stamp = t;
-  const Eigen::Isometry3d T_pred = pose_of(predicted) * config_.T_imu_lidar;
+  const Eigen::Isometry3d T_pred = imu::T_map_imu(predicted) * config_.T_imu_lidar;
 
   const auto points = scan.points.as<LidarPoint>();
   const std::span<const LidarPoint> point_span(points.data(), scan.point_count);
@@ -426,14 +419,14 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
   begin(LioStep::kMapUpdate);
   if (match.ok) {
     ++figures_.scans_used;
-    const Eigen::Isometry3d T_map_lidar = pose_of(estimate) * config_.T_imu_lidar;
+    const Eigen::Isometry3d T_map_lidar = imu::T_map_imu(estimate) * config_.T_imu_lidar;
     matched_[0] = matched_[1];
     matched_[1] = {t, T_map_lidar};
     matched_start_ = scan.start_stamp;
     ++matched_scans_;
     if (lidar_.commit(T_map_lidar) && config_.keep_map) {
       map_cloud_.add(lidar_.deskewed(), T_map_lidar);
-      map_keyframes_.push_back({t, pose_of(estimate)});
+      map_keyframes_.push_back({t, imu::T_map_imu(estimate)});
     }
   }
   anchor_cov_ = window_.size() > 1 ? window_.latest_pose_covariance()
@@ -549,7 +542,7 @@ imu::ImuState LioEstimator::initial_value(const imu::ImuState& predicted,
   std::vector<WeightedPosition> cameras;
   std::optional<Eigen::Matrix3d> R_cio;
   for (const RelativeMotion& m : motions_) {
-    const Eigen::Isometry3d T = pose_of(previous) * m.T_i_j;
+    const Eigen::Isometry3d T = imu::T_map_imu(previous) * m.T_i_j;
     const Eigen::Matrix3d cov_t = covariance_of(m.information).bottomRightCorner<3, 3>();
     cameras.push_back({T.translation(), in_map(T.linear(), cov_t.inverse())});
     if (!R_cio) R_cio = T.linear();

@@ -19,13 +19,6 @@ namespace {
 constexpr double kMargImuHz = 200.0;
 constexpr double kMargStep = 0.1;
 
-Eigen::Isometry3d marg_pose_of(const imu::ImuState& s) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = s.q_map_imu.toRotationMatrix();
-  T.translation() = s.p_map_imu_m;
-  return T;
-}
-
 /// The IMU's samples over the step ending at `t`, with white noise at `noise_density`,
 /// preintegrated from `prev`.
 imu::Preintegration noisy_preintegration(const test::AnalyticMotion& m,
@@ -74,7 +67,7 @@ imu::ImuState run_window(int size, int steps) {
     guess.stamp = m.state(t).stamp;
     // The camera's motion since the previous state, with noise.
     Eigen::Isometry3d T_ij =
-        marg_pose_of(m.state(t - kMargStep)).inverse() * marg_pose_of(m.state(t));
+        imu::T_map_imu(m.state(t - kMargStep)).inverse() * imu::T_map_imu(m.state(t));
     T_ij.translation() += sigma_p * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
     T_ij.linear() =
         T_ij.linear() * so3::exp(sigma_r * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)));
@@ -138,12 +131,12 @@ imu::ImuState run_landmark_window(int size, int steps) {
     imu::ImuState guess = pre.predict(prev, m.gravity_mps2);
     guess.stamp = m.state(t).stamp;
     w.add(guess, pre, std::nullopt);
-    const Eigen::Isometry3d T_map_j = marg_pose_of(m.state(t));
+    const Eigen::Isometry3d T_map_j = imu::T_map_imu(m.state(t));
     for (const Point& p : points) {
       if (k - p.anchor_step > 3) continue;
       const Eigen::Vector3d P_c =
           (T_map_j * T_body_cam).inverse() *
-          (marg_pose_of(m.state(p.anchor_step * kMargStep)) * p.X_anchor_true);
+          (imu::T_map_imu(m.state(p.anchor_step * kMargStep)) * p.X_anchor_true);
       const Eigen::Vector2d observed =
           P_c.hnormalized() + Eigen::Vector2d(n01(rng), n01(rng)) / kFocalPx;
       EXPECT_TRUE(w.add_factor(
