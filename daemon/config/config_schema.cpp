@@ -418,10 +418,10 @@ const Field kSchema[] = {
     F("estimator.camera_floor_translation_m", estimator.camera_floor_translation_m, "0.002", "m", 0,
       1, "", "1-sigma added to each camera factor's translation (features are not independent)"),
     F("estimator.camera_strong_lidar_floor_translation_m",
-      estimator.camera_strong_lidar_floor_translation_m, "0.03", "m", 0, 1, "",
+      estimator.camera_strong_lidar_floor_translation_m, "0.002", "m", 0, 1, "",
       "the same where the lidar is strong and settled (see camera_strong_lidar_after_s): 0.03 "
-      "keeps an open site within about 1 mm of the lidar alone, where 0.002 left it up to 8 mm "
-      "worse (docs/estimator.md)"),
+      "keeps a 2-minute open site within about 1 mm of the lidar alone, where 0.002 leaves it up "
+      "to 8 mm worse, but cost 10-minute campus drives up to 3 m (docs/estimator.md)"),
     F("estimator.camera_strong_lidar_after_s", estimator.camera_strong_lidar_after_s, "5", "s", 0,
       3600, "",
       "the strong-lidar floor applies only once every scan for this long pinned every direction "

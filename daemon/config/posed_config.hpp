@@ -246,7 +246,7 @@ struct EstimatorSection {
   double camera_rejoin_gradient = 0.04;       ///< [0..1]
   double camera_floor_translation_m = 0.002;  ///< 1-sigma floor per factor [m]
   /// the same where the lidar is strong (no degenerate scan lately) [m]
-  double camera_strong_lidar_floor_translation_m = 0.03;
+  double camera_strong_lidar_floor_translation_m = 0.002;
   /// the strong-lidar floor only once every scan for this long pinned every direction [s]
   double camera_strong_lidar_after_s = 5;
   double camera_floor_rotation_deg = 0.06;    ///< 1-sigma floor per factor [deg]

@@ -90,9 +90,10 @@ TEST(FrontendConfig, TheCameraCouplingAndTheLandmarksThresholdsAreTheConfiguredO
       factors_of("estimator:\n  camera_guess_gate_px: 2.5\n  camera_weak_lidar_guess_gate_px: 9\n");
   EXPECT_DOUBLE_EQ(g.guess_gate_px, 2.5);
   EXPECT_DOUBLE_EQ(g.weak_lidar_guess_gate_px, 9);
-  // The translation floor: 2 mm by default, and 30 mm where the lidar pins the motion.
+  // The translation floor: 2 mm by default wherever the lidar is, and its own key where the
+  // lidar pins the motion.
   EXPECT_DOUBLE_EQ(factors_of("").floor_translation_m, 0.002);
-  EXPECT_DOUBLE_EQ(factors_of("").strong_lidar_floor_translation_m, 0.03);
+  EXPECT_DOUBLE_EQ(factors_of("").strong_lidar_floor_translation_m, 0.002);
   EXPECT_DOUBLE_EQ(factors_of("estimator:\n  camera_strong_lidar_floor_translation_m: 0.01\n")
                        .strong_lidar_floor_translation_m,
                    0.01);
