@@ -40,11 +40,8 @@ class CompactCloud {
   void push_back(const Eigen::Vector3f& p) {
     points_.push_back({quantise(p.x()), quantise(p.y()), quantise(p.z())});
   }
-  void reserve(std::size_t n) { points_.reserve(n); }
-  void shrink_to_fit() { points_.shrink_to_fit(); }
 
   std::size_t size() const { return points_.size(); }
-  bool empty() const { return points_.empty(); }
   /// The i-th point [m].
   Eigen::Vector3f operator[](std::size_t i) const {
     const std::array<std::int16_t, 3>& q = points_[i];

@@ -418,13 +418,16 @@ bool read_cloud(const std::string& path, mapping::KeyframeMap& map, std::string&
     const auto offset = static_cast<long long>(in.tellg());
     in.read(reinterpret_cast<char*>(block.data()), static_cast<std::streamsize>(n * sizeof(Point)));
     const auto got = static_cast<std::size_t>(in.gcount()) / sizeof(Point);
+    // "point N (byte B)": where in the file the k-th point of this block is.
+    const auto point_at = [&](std::size_t k) {
+      return "point " + std::to_string(first + k) + " (byte " +
+             std::to_string(offset + static_cast<long long>(k * sizeof(Point))) + ")";
+    };
     for (std::size_t k = 0; k < got; ++k) {
       const Point& p = block[k];
       if (p.keyframe >= map.keyframes.size()) {
         error = at(path, 0,
-                   "point " + std::to_string(first + k) + " (byte " +
-                       std::to_string(offset + static_cast<long long>(k * sizeof(Point))) +
-                       ") belongs to keyframe " + std::to_string(p.keyframe) + " of " +
+                   point_at(k) + " belongs to keyframe " + std::to_string(p.keyframe) + " of " +
                        std::to_string(map.keyframes.size()));
         return false;
       }
@@ -434,9 +437,7 @@ bool read_cloud(const std::string& path, mapping::KeyframeMap& map, std::string&
         std::snprintf(where, sizeof where, "(%.1f, %.1f, %.1f) m from it", p_base.x(), p_base.y(),
                       p_base.z());
         error = at(path, 0,
-                   "point " + std::to_string(first + k) + " (byte " +
-                       std::to_string(offset + static_cast<long long>(k * sizeof(Point))) +
-                       ") of keyframe " + std::to_string(p.keyframe) + " is " + where +
+                   point_at(k) + " of keyframe " + std::to_string(p.keyframe) + " is " + where +
                        ": a keyframe keeps its points within " +
                        std::to_string(static_cast<int>(mapping::CompactCloud::kReachM)) +
                        " m of itself on every axis");
