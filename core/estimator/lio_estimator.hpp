@@ -111,6 +111,9 @@ class LioEstimator final : public FusionCore {
   void set_probe(LioStepProbe* probe) { probe_ = probe; }
   /// Optional: further relative-motion factors for every new state (the cameras; null: none).
   void set_aiding(WindowAiding* aiding) { aiding_ = aiding; }
+  /// Optional: helper threads for the lidar front end's per-point work (null: the caller's
+  /// thread does all of it). The estimate is bit-identical either way (core/work_splitter.hpp).
+  void set_splitter(WorkSplitter* splitter) { lidar_.set_splitter(splitter); }
 
   void add_imu(const ImuSample& sample, std::vector<NavState>& states) override;
   void add_scan(LidarScan scan, std::vector<NavState>& states) override;

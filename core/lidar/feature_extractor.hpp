@@ -15,10 +15,12 @@
 //     edges (at most `edges_per_sector`, never two within 5 pixels), and every pixel below
 //     `plane_threshold` (ground included) is a plane candidate, voxel-downsampled.
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "core/lidar/scan_motion.hpp"
+#include "core/work_splitter.hpp"
 
 namespace posed::lidar {
 
@@ -57,18 +59,31 @@ class FeatureExtractor {
   /// Extracts the features of `points` into `out` (cleared first). Buffers are reused.
   void extract(const std::vector<ScanPoint>& points, ScanFeatures& out);
   const FeatureConfig& config() const { return config_; }
+  /// Where the rings' steps 3-5 run in parts (null: here). The features are the same either way.
+  void set_splitter(WorkSplitter* splitter) { splitter_ = splitter; }
 
  private:
+  /// The rings are cut into this many parts, each with its own scratch and outputs, joined in
+  /// ring order.
+  static constexpr std::size_t kParts = 4;
+  struct RingPart {
+    // per ring: the valid pixels in column order
+    std::vector<std::int32_t> ring_points;
+    std::vector<float> smoothness;
+    std::vector<std::uint8_t> excluded;
+    std::vector<std::int32_t> order;
+    std::vector<Eigen::Vector3f> edges, planes;  // of this part's rings, in ring order
+  };
+  /// Steps 3-5 for ring `r`, appending to `part`'s edges and planes.
+  void ring_features(const std::vector<ScanPoint>& points, int r, RingPart& part) const;
+
   FeatureConfig config_;
+  WorkSplitter* splitter_ = nullptr;
   // range image: point index per pixel, -1 = empty
   std::vector<std::int32_t> pixel_;
   std::vector<std::uint8_t> ground_;
-  // per ring: the valid pixels in column order
-  std::vector<std::int32_t> ring_points_;
-  std::vector<float> smoothness_;
-  std::vector<std::uint8_t> excluded_;
-  std::vector<std::int32_t> order_;
-  std::vector<std::uint64_t> voxel_keys_;
+  std::array<RingPart, kParts> parts_;
+  std::array<std::vector<std::uint64_t>, 2> voxel_keys_;  // the planes', the edges'
 };
 
 /// Keeps one point per voxel of `voxel_m` (the one closest to the voxel's centre), in place.

@@ -63,6 +63,11 @@ class LidarOdometry {
   void set_translation_degeneracy(double threshold, double information_scale) {
     matcher_.set_translation_degeneracy(threshold, information_scale);
   }
+  /// Where the feature extraction's and the scan match's parts run (null: here).
+  void set_splitter(WorkSplitter* splitter) {
+    extractor_.set_splitter(splitter);
+    matcher_.set_splitter(splitter);
+  }
   /// Forgets the map and keyframes (re-initialisation after divergence).
   void reset();
 

@@ -67,50 +67,69 @@ void ScanMatcher::associate(const std::vector<Eigen::Vector3f>& edges_lidar,
                             const std::vector<Eigen::Vector3f>& planes_lidar,
                             const VoxelMap& edge_map, const VoxelMap& plane_map,
                             const Eigen::Isometry3d& T) {
-  correspondences_.clear();
-  correspondences_.reserve(edges_lidar.size() + planes_lidar.size());
   const Eigen::Isometry3f Tf = T.cast<float>();
   const int k = config_.neighbours;
   const auto max_d = static_cast<float>(config_.max_correspondence_m);
-  Eigen::Vector3f nn[16];
 
-  // Mean and covariance of the neighbours: the line or plane they lie on.
-  const auto fit = [&](int n, Eigen::Vector3d& mean,
-                       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& es) {
-    mean.setZero();
-    for (int i = 0; i < n; ++i) mean += nn[i].cast<double>();
-    mean /= n;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3d d = nn[i].cast<double>() - mean;
-      cov.noalias() += d * d.transpose();
+  // One part: a contiguous share of the edges and of the planes, into its own outputs (the
+  // map is only read), so the parts may run at once.
+  const auto search = [&](std::size_t part) {
+    std::vector<Correspondence>& edges_out = part_edges_[part];
+    std::vector<Correspondence>& planes_out = part_planes_[part];
+    edges_out.clear();
+    planes_out.clear();
+    Eigen::Vector3f nn[16];
+    // Mean and covariance of the neighbours: the line or plane they lie on.
+    const auto fit = [&](int n, Eigen::Vector3d& mean,
+                         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& es) {
+      mean.setZero();
+      for (int i = 0; i < n; ++i) mean += nn[i].cast<double>();
+      mean /= n;
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d d = nn[i].cast<double>() - mean;
+        cov.noalias() += d * d.transpose();
+      }
+      es.computeDirect(cov / n);  // eigenvalues ascending
+    };
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    const PartRange edges = part_range(edges_lidar.size(), part, kParts);
+    for (std::size_t i = edges.begin; i < edges.end; ++i) {
+      const Eigen::Vector3f& p = edges_lidar[i];
+      if (edge_map.nearest(Tf * p, k, max_d, nn) < k) continue;
+      Eigen::Vector3d mean;
+      fit(k, mean, es);
+      const Eigen::Vector3d l = es.eigenvalues();
+      if (l(2) < config_.edge_min_linearity * std::max(l(1), 1e-9)) continue;  // not a line
+      edges_out.push_back({p.cast<double>(), mean, es.eigenvectors().col(2), false});
     }
-    es.computeDirect(cov / n);  // eigenvalues ascending
+    const PartRange planes = part_range(planes_lidar.size(), part, kParts);
+    for (std::size_t i = planes.begin; i < planes.end; ++i) {
+      const Eigen::Vector3f& p = planes_lidar[i];
+      if (plane_map.nearest(Tf * p, k, max_d, nn) < k) continue;
+      Eigen::Vector3d mean;
+      fit(k, mean, es);
+      // Neighbours along one ring are nearly collinear: their "plane" could face anywhere.
+      const Eigen::Vector3d l = es.eigenvalues();
+      if (l(1) < config_.plane_min_spread_ratio * l(2)) continue;
+      const Eigen::Vector3d normal = es.eigenvectors().col(0);
+      bool flat = true;
+      for (int j = 0; j < k && flat; ++j) {
+        flat = std::abs(normal.dot(nn[j].cast<double>() - mean)) <= config_.plane_max_error_m;
+      }
+      if (!flat) continue;
+      planes_out.push_back({p.cast<double>(), mean, normal, true});
+    }
   };
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-  for (const Eigen::Vector3f& p : edges_lidar) {
-    if (edge_map.nearest(Tf * p, k, max_d, nn) < k) continue;
-    Eigen::Vector3d mean;
-    fit(k, mean, es);
-    const Eigen::Vector3d l = es.eigenvalues();
-    if (l(2) < config_.edge_min_linearity * std::max(l(1), 1e-9)) continue;  // not a line
-    correspondences_.push_back({p.cast<double>(), mean, es.eigenvectors().col(2), false});
-  }
-  for (const Eigen::Vector3f& p : planes_lidar) {
-    if (plane_map.nearest(Tf * p, k, max_d, nn) < k) continue;
-    Eigen::Vector3d mean;
-    fit(k, mean, es);
-    // Neighbours along one ring are nearly collinear: their "plane" could face anywhere.
-    const Eigen::Vector3d l = es.eigenvalues();
-    if (l(1) < config_.plane_min_spread_ratio * l(2)) continue;
-    const Eigen::Vector3d normal = es.eigenvectors().col(0);
-    bool flat = true;
-    for (int i = 0; i < k && flat; ++i) {
-      flat = std::abs(normal.dot(nn[i].cast<double>() - mean)) <= config_.plane_max_error_m;
-    }
-    if (!flat) continue;
-    correspondences_.push_back({p.cast<double>(), mean, normal, true});
-  }
+  run_parts(splitter_, kParts, search);
+
+  // Edges before planes, each in scan order: the order the sums in normal_equations() take.
+  correspondences_.clear();
+  correspondences_.reserve(edges_lidar.size() + planes_lidar.size());
+  for (const auto& part : part_edges_)
+    correspondences_.insert(correspondences_.end(), part.begin(), part.end());
+  for (const auto& part : part_planes_)
+    correspondences_.insert(correspondences_.end(), part.begin(), part.end());
 }
 
 ScanMatchResult ScanMatcher::match(const std::vector<Eigen::Vector3f>& edges_lidar,

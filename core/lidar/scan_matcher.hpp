@@ -18,10 +18,12 @@
 // its threshold would depend on the scene's size.
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "core/lidar/voxel_map.hpp"
+#include "core/work_splitter.hpp"
 
 namespace posed::lidar {
 
@@ -106,14 +108,23 @@ class ScanMatcher {
     config_.degeneracy_translation_threshold = threshold;
     config_.degenerate_information_scale = information_scale;
   }
+  /// Where the correspondence search's parts run (null: here). The correspondences, and so the
+  /// match, are the same either way.
+  void set_splitter(WorkSplitter* splitter) { splitter_ = splitter; }
 
  private:
+  /// Parts of the correspondence search: more than helper threads, so a part a busy helper has
+  /// not taken yet is taken by the caller.
+  static constexpr std::size_t kParts = 4;
   void associate(const std::vector<Eigen::Vector3f>& edges_lidar,
                  const std::vector<Eigen::Vector3f>& planes_lidar, const VoxelMap& edge_map,
                  const VoxelMap& plane_map, const Eigen::Isometry3d& T);
 
   ScanMatcherConfig config_;
+  WorkSplitter* splitter_ = nullptr;
   std::vector<Correspondence> correspondences_;
+  /// per part: its edges' and its planes' correspondences, joined in part order
+  std::array<std::vector<Correspondence>, kParts> part_edges_, part_planes_;
 };
 
 /// Gauss-Newton normal equations of `correspondences` at T (right perturbation, rotation first):

@@ -580,6 +580,14 @@ const Field kSchema[] = {
     F("threads.camera_frontend.cpu", threads.camera_frontend.cpu, "-1", "", -1, 1023, "",
       "CPU the camera front end's thread is pinned to (-1 = any); it works beside the fusion "
       "thread, so not the fusion thread's CPU"),
+    F("threads.lidar_helpers", threads.lidar_helpers, "1", "threads", 0, 16, "",
+      "helper threads that search the scan match's correspondences beside the fusion thread "
+      "(posed-lidar-N; 0 = the fusion thread alone); the poses are the same either way"),
+    F("threads.lidar_helper.priority", threads.lidar_helper.priority, "0", "", 0, 50, "",
+      "SCHED_FIFO priority of the scan match's helper threads (0 = normal scheduling)"),
+    F("threads.lidar_helper.cpu", threads.lidar_helper.cpu, "-1", "", -1, 1023, "",
+      "CPU the scan match's helper threads are pinned to (-1 = any); they work while the fusion "
+      "thread does, so not the fusion thread's CPU"),
     F("threads.publisher.priority", threads.publisher.priority, "0", "", 0, 50, "",
       "SCHED_FIFO priority of the DDS publisher thread (0 = normal scheduling)"),
     F("threads.publisher.cpu", threads.publisher.cpu, "-1", "", -1, 1023, "",

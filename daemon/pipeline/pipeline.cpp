@@ -13,6 +13,7 @@
 #include "daemon/pipeline/frontend_config.hpp"
 #include "daemon/pipeline/fusion_stage.hpp"
 #include "daemon/pipeline/imu_stage.hpp"
+#include "daemon/pipeline/lidar_helper.hpp"
 #include "daemon/pipeline/lidar_stage.hpp"
 #include "daemon/pipeline/publisher_stage.hpp"
 #include "daemon/pipeline/realsense_imu_stage.hpp"
@@ -225,6 +226,11 @@ bool Pipeline::start(std::string& error) {
   estimator::LioEstimator* lio = nullptr;
   std::unique_ptr<FusionCore> core =
       make_core(config_, sources_.lidar != nullptr, outputs_.keep_map, lio);
+  if (lio != nullptr && config_.threads.lidar_helpers > 0) {
+    lidar_helper_ = std::make_unique<LidarHelper>(
+        config_.threads.lidar_helper, static_cast<std::size_t>(config_.threads.lidar_helpers));
+    lio->set_splitter(lidar_helper_.get());
+  }
   core = with_cameras(std::move(core), lio, config_, sources_.visible != nullptr,
                       sources_.thermal != nullptr, in_stamp_order, outputs_, camera_lane_,
                       camera_lane_beat_, camera_core_);

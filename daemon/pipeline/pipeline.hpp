@@ -46,6 +46,7 @@ class RealsenseImuStage;
 class LidarStage;
 class CameraStage;
 class CameraLane;
+class LidarHelper;
 class FusionStage;
 class PublisherStage;
 struct LidarScanCounters;
@@ -223,6 +224,9 @@ class Pipeline {
   /// fusion stage, whose core posts to it, so it outlives that core
   Heartbeat camera_lane_beat_{"camera_frontend"};
   std::unique_ptr<CameraLane> camera_lane_;
+  /// the scan match's helper threads (threads.lidar_helpers); before the fusion stage, whose
+  /// core runs parts on them
+  std::unique_ptr<LidarHelper> lidar_helper_;
   std::unique_ptr<FusionStage> fusion_stage_;
   /// the fusion core when it has cameras (owned by fusion_stage_)
   const fusion::CameraAidedCore* camera_core_ = nullptr;

@@ -1,6 +1,9 @@
 // posectl bench lio: per-scan cost of the lidar-inertial estimator on one core, with the
 // breakdown by step, on simulated VLP-32C scans (~55k points) and A9 samples of the default rig
 // driving `street_night`, decoded by the real drivers. Also the trajectory error of that run.
+// Then the same scans again with one helper thread for the lidar front end (threads.lidar_helpers,
+// as posed runs by default): its cost per scan, and whether every pose came out the same (give the
+// bench two CPUs for that run to mean anything; `taskset -c 0` shares one between the two).
 
 #include <algorithm>
 #include <array>
@@ -11,6 +14,7 @@
 #include "core/estimator/lio_estimator.hpp"
 #include "daemon/config/config_loader.hpp"
 #include "daemon/pipeline/estimator_config.hpp"
+#include "daemon/pipeline/lidar_helper.hpp"
 #include "drivers/velodyne/scan_builder.hpp"
 #include "tools/posectl/bench.hpp"
 #include "tools/sim/lidar_imu_run.hpp"
@@ -60,31 +64,21 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
-}  // namespace
-
-int bench_lio() {
-  const config::PosedConfig config = config::default_config();  // the M2DGR rig
-  sim::SimOptions options;
-  options.scenario = "street_night";
-  options.duration_s = 40.0;
-  options.seed = 3;
-  std::fprintf(stderr, "posectl bench lio: simulating %s for %.0f s (lidar + IMU)...\n",
-               options.scenario.c_str(), options.duration_s);
-  sim::LidarImuRun run;
-  std::string error;
-  if (!sim::simulate_lidar_imu(sim::rig_from_config(config), options, run, error)) {
-    std::fprintf(stderr, "posectl bench lio: %s\n", error.c_str());
-    return 1;
-  }
-  estimator::LioEstimator lio(pipeline::lio_config(config));
+/// One pass of the simulated run through a fresh estimator; `splitter` (optional) for the match.
+struct LioRun {
   StepTimer timer;
-  lio.set_probe(&timer);
+  std::vector<NavState> states;
+  double points = 0;
+};
+
+void run_estimator(const config::PosedConfig& config, const sim::LidarImuRun& run,
+                   WorkSplitter* splitter, LioRun& out) {
+  estimator::LioEstimator lio(pipeline::lio_config(config));
+  lio.set_probe(&out.timer);
+  lio.set_splitter(splitter);
   PayloadPool pool(4,
                    drivers::velodyne::max_points_per_scan(config.lidar.rpm) * sizeof(LidarPoint));
-  std::vector<NavState> states;
   std::size_t next_scan = 0;
-  double points = 0;
-  std::fprintf(stderr, "posectl bench lio: %zu scans through the estimator...\n", run.scans.size());
   for (const ImuSample& imu : run.imu) {
     while (next_scan < run.scans.size() && run.scans[next_scan].end < imu.stamp) {
       const sim::DecodedScan& s = run.scans[next_scan++];
@@ -94,15 +88,17 @@ int bench_lio() {
       scan.points = pool.acquire();
       std::copy(s.points.begin(), s.points.end(), scan.points.as<LidarPoint>().begin());
       scan.point_count = static_cast<std::uint32_t>(s.points.size());
-      points += static_cast<double>(s.points.size());
-      lio.add_scan(std::move(scan), states);
-      timer.finish_scan();
+      out.points += static_cast<double>(s.points.size());
+      lio.add_scan(std::move(scan), out.states);
+      out.timer.finish_scan();
     }
-    lio.add_imu(imu, states);  // releases the scan the IMU now covers
-    timer.finish_scan();
+    lio.add_imu(imu, out.states);  // releases the scan the IMU now covers
+    out.timer.finish_scan();
   }
+}
 
-  // Trajectory error of the optimised poses, after the best rigid alignment.
+/// ATE RMSE of the optimised poses after the best rigid alignment [m].
+double ate_rmse(const std::vector<NavState>& states, const sim::LidarImuRun& run) {
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs;
   for (const NavState& s : states) {
     if (s.optimised) pairs.emplace_back(s.p_map_base_m, run.T_map_base(s.stamp).translation());
@@ -123,20 +119,76 @@ int bench_lio() {
   const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
   double sq = 0;
   for (const auto& [e, g] : pairs) sq += (R * (e - me) + mg - g).squaredNorm();
+  return std::sqrt(sq / n);
+}
 
-  const std::vector<double>& totals = timer.totals();
+bool same_poses(const std::vector<NavState>& a, const std::vector<NavState>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].stamp != b[i].stamp || a[i].p_map_base_m != b[i].p_map_base_m ||
+        a[i].q_map_base.coeffs() != b[i].q_map_base.coeffs()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int bench_lio() {
+  const config::PosedConfig config = config::default_config();  // the M2DGR rig
+  sim::SimOptions options;
+  options.scenario = "street_night";
+  options.duration_s = 40.0;
+  options.seed = 3;
+  std::fprintf(stderr, "posectl bench lio: simulating %s for %.0f s (lidar + IMU)...\n",
+               options.scenario.c_str(), options.duration_s);
+  sim::LidarImuRun run;
+  std::string error;
+  if (!sim::simulate_lidar_imu(sim::rig_from_config(config), options, run, error)) {
+    std::fprintf(stderr, "posectl bench lio: %s\n", error.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "posectl bench lio: %zu scans through the estimator...\n", run.scans.size());
+  LioRun alone;
+  run_estimator(config, run, nullptr, alone);
+
+  const std::vector<double>& totals = alone.timer.totals();
   report("lio", "scans", static_cast<double>(totals.size()), "count");
   report("lio", "points_per_scan_mean",
-         points / std::max<double>(1.0, static_cast<double>(run.scans.size())), "points");
+         alone.points / std::max<double>(1.0, static_cast<double>(run.scans.size())), "points");
   for (std::size_t i = 0; i < estimator::kLioStepNames.size(); ++i) {
     const std::string name(estimator::kLioStepNames[i]);
-    report("lio", name + "_median", percentile(timer.step(i), 0.5), "ms");
-    report("lio", name + "_p99", percentile(timer.step(i), 0.99), "ms");
+    report("lio", name + "_median", percentile(alone.timer.step(i), 0.5), "ms");
+    report("lio", name + "_p99", percentile(alone.timer.step(i), 0.99), "ms");
   }
   report("lio", "per_scan_median", percentile(totals, 0.5), "ms");
   report("lio", "per_scan_p99", percentile(totals, 0.99), "ms");
   report("lio", "per_scan_max", percentile(totals, 1.0), "ms");
-  report("lio", "ate_rmse", std::sqrt(sq / n), "m");
+  report("lio", "ate_rmse", ate_rmse(alone.states, run), "m");
+
+  std::fprintf(stderr,
+               "posectl bench lio: again with a helper thread for the lidar front end...\n");
+  LioRun helped;
+  {
+    pipeline::LidarHelper helper(config::ThreadSection{}, 1);
+    run_estimator(config, run, &helper, helped);
+    const pipeline::LidarHelperCounters c = helper.counters();
+    report("lio", "helper_share_of_parts",
+           c.parts > 0 ? static_cast<double>(c.helper_parts) / static_cast<double>(c.parts) : 0,
+           "ratio");
+  }
+  for (const estimator::LioStep step :
+       {estimator::LioStep::kDeskew, estimator::LioStep::kFeatures, estimator::LioStep::kMatch}) {
+    const auto i = static_cast<std::size_t>(step);
+    const std::string name(estimator::kLioStepNames[i]);
+    report("lio", "helper_" + name + "_median", percentile(helped.timer.step(i), 0.5), "ms");
+    report("lio", "helper_" + name + "_p99", percentile(helped.timer.step(i), 0.99), "ms");
+  }
+  report("lio", "helper_per_scan_median", percentile(helped.timer.totals(), 0.5), "ms");
+  report("lio", "helper_per_scan_p99", percentile(helped.timer.totals(), 0.99), "ms");
+  report("lio", "helper_ate_rmse", ate_rmse(helped.states, run), "m");
+  report("lio", "helper_poses_identical", same_poses(alone.states, helped.states) ? 1 : 0, "bool");
   return 0;
 }
 

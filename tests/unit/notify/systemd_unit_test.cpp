@@ -184,9 +184,10 @@ TEST(SystemdUnit, LimitRtprioMatchesTheConfigPriorityCap) {
   const config::LoadResult shipped = config::load_config_file(config_path.string());
   ASSERT_TRUE(shipped.ok()) << shipped.error_text();
   const auto& threads = shipped.config.threads;
-  const int highest = std::max({threads.imu_source.priority, threads.lidar_source.priority,
-                                threads.fusion.priority, threads.camera_source.priority,
-                                threads.camera_frontend.priority, threads.publisher.priority});
+  const int highest =
+      std::max({threads.imu_source.priority, threads.lidar_source.priority, threads.fusion.priority,
+                threads.camera_source.priority, threads.camera_frontend.priority,
+                threads.publisher.priority, threads.lidar_helper.priority});
   EXPECT_LE(highest, limit) << config_path << " asks for SCHED_FIFO " << highest << " but " << unit
                             << " allows " << limit;
 
