@@ -581,8 +581,9 @@ const Field kSchema[] = {
       "CPU the camera front end's thread is pinned to (-1 = any); it works beside the fusion "
       "thread, so not the fusion thread's CPU"),
     F("threads.lidar_helpers", threads.lidar_helpers, "1", "threads", 0, 16, "",
-      "helper threads that search the scan match's correspondences beside the fusion thread "
-      "(posed-lidar-N; 0 = the fusion thread alone); the poses are the same either way"),
+      "helper threads for the scan match's correspondence search and the feature extraction, "
+      "beside the fusion thread "
+      "(posed-lidar-hN; 0 = the fusion thread alone); the poses are the same either way"),
     F("threads.lidar_helper.priority", threads.lidar_helper.priority, "0", "", 0, 50, "",
       "SCHED_FIFO priority of the scan match's helper threads (0 = normal scheduling)"),
     F("threads.lidar_helper.cpu", threads.lidar_helper.cpu, "-1", "", -1, 1023, "",

@@ -278,7 +278,7 @@ struct ThreadsSection {
   ThreadSection camera_source;
   ThreadSection camera_frontend;  ///< posed-camera: the camera front end (frontend.own_thread)
   ThreadSection publisher;
-  /// posed-lidar-N: helpers of the fusion thread's scan match (0: the fusion thread alone)
+  /// posed-lidar-hN: helpers of the fusion thread's scan match (0: the fusion thread alone)
   int lidar_helpers = 1;
   ThreadSection lidar_helper;
 };

@@ -57,7 +57,7 @@ void LidarHelper::run(std::size_t parts, const Part& part) {
 }
 
 void LidarHelper::work(config::ThreadSection policy, std::size_t index) {
-  apply_thread_policy("posed-lidar-" + std::to_string(index + 1), policy);
+  apply_thread_policy("posed-lidar-h" + std::to_string(index + 1), policy);
   std::unique_lock lock(mutex_);
   // No job was posted before the helpers were made: one posted before this thread got here is
   // still to be joined, so start from 0, not from generation_.

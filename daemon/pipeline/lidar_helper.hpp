@@ -28,7 +28,7 @@ struct LidarHelperCounters {
 
 class LidarHelper final : public WorkSplitter {
  public:
-  /// Starts `threads` helpers ("posed-lidar-N") under `policy`.
+  /// Starts `threads` helpers ("posed-lidar-hN") under `policy`.
   LidarHelper(const config::ThreadSection& policy, std::size_t threads);
   ~LidarHelper() override;
   LidarHelper(const LidarHelper&) = delete;

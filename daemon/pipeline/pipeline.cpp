@@ -216,13 +216,16 @@ bool Pipeline::start(std::string& error) {
       return [stage = camera_stages_[i].get()] { stage->run(); };
     });
   }
-  // Recordings and generators at full speed: merge by stamp so replays are deterministic.
-  bool in_stamp_order = !sources_.imu->live();
+  // Recordings and generators: merge by stamp so replays are deterministic. Not a replay with
+  // live stamps: merged by stamp, each scan would wait for the next (every stream must have
+  // passed its end), and the poses would be a scan period later than on the robot.
+  bool in_stamp_order = !sources_.imu->live() && !sources_.live_stamps;
   for (const drivers::Source* s :
        {sources_.lidar.get(), sources_.visible.get(), sources_.thermal.get(),
         sources_.realsense_imu.get(), sources_.depth.get()}) {
     if (s != nullptr && s->live()) in_stamp_order = false;
   }
+  in_stamp_order_ = in_stamp_order;
   estimator::LioEstimator* lio = nullptr;
   std::unique_ptr<FusionCore> core =
       make_core(config_, sources_.lidar != nullptr, outputs_.keep_map, lio);

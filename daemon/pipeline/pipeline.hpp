@@ -77,6 +77,10 @@ struct PipelineSources {
   /// recordings replayed at recorded timing (or N times it), not as fast as they go: the
   /// odometry then runs as it would live rather than waiting for the back end
   bool paced = false;
+  /// a paced replay re-stamped onto the host clock now (posed --live-stamps): the pipeline takes
+  /// its streams as it takes live ones (in arrival order, not merged by stamp, which would hold
+  /// each scan back until the next one came), so what subscribers measure is the robot's latency
+  bool live_stamps = false;
 
   /// The camera Source of a stream (null when absent).
   std::unique_ptr<drivers::Source>& camera(CameraStream s) {
@@ -162,6 +166,10 @@ class Pipeline {
   std::string_view odometry_mode() const {
     return odometry_ ? "imu_thread" : in_order_odometry_ ? "in_order" : "back_end";
   }
+  /// Whether the fusion stage merges its streams by stamp (recordings and generators at full or
+  /// recorded speed; deterministic) rather than taking them as they come (live, and replays with
+  /// live stamps). Valid after start().
+  bool merges_in_stamp_order() const { return in_stamp_order_; }
   /// The fusion core's one-line description (valid after start()).
   std::string estimator_description() const;
   /// The fusion core's map and keyframes (call after join(); empty without a lidar or keep_map).
@@ -239,6 +247,7 @@ class Pipeline {
   /// the same in a max-speed replay, on the fusion stage's thread in data order
   std::unique_ptr<estimator::OdometryPropagator> in_order_odometry_;
   bool started_ = false;
+  bool in_stamp_order_ = false;
   std::atomic<std::size_t> finished_stages_{0};
   std::vector<std::thread> threads_;
 };

@@ -106,6 +106,7 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   };
   out.built.sources.imu = make("imu");
   out.built.sources.paced = options.rate > 0;
+  out.built.sources.live_stamps = options.live_stamps;
   if (streams.count("lidar")) {
     out.built.sources.lidar = make("lidar");
     if (options.recorded_config) {

@@ -65,9 +65,11 @@ class CorruptingSource final : public drivers::Source {
 struct RunResult {
   std::vector<NavState> states;
   PipelineStatus final_status;
+  bool merged_in_stamp_order = false;
 };
 
-RunResult run(std::unique_ptr<drivers::Source> source, const config::PosedConfig& c) {
+RunResult run(std::unique_ptr<drivers::Source> source, const config::PosedConfig& c,
+              bool live_stamps = false) {
   RunResult result;
   std::mutex m;
   PipelineOutputs outputs;
@@ -81,9 +83,11 @@ RunResult run(std::unique_ptr<drivers::Source> source, const config::PosedConfig
   };
   PipelineSources sources;
   sources.imu = std::move(source);
+  sources.live_stamps = live_stamps;
   Pipeline pipe(c, std::move(sources), std::move(outputs));
   std::string error;
   EXPECT_TRUE(pipe.start(error)) << error;
+  result.merged_in_stamp_order = pipe.merges_in_stamp_order();
   for (int i = 0; i < 2000 && !pipe.finished(); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -128,6 +132,18 @@ TEST(Pipeline, ReplayAtFullSpeedIsDeterministic) {
     ASSERT_EQ(a.states[i].p_map_base_m, b.states[i].p_map_base_m) << i;  // bit-identical
     ASSERT_EQ(a.states[i].q_map_base.coeffs(), b.states[i].q_map_base.coeffs()) << i;
   }
+}
+
+// A replay with live stamps is taken as a live run is: merged by stamp, each scan would wait for
+// the next one before the IMU past its end could release it, a scan period late.
+TEST(Pipeline, OnlyRecordingsWithoutLiveStampsAreMergedByStamp) {
+  const auto c = test_config();
+  EXPECT_TRUE(
+      run(std::make_unique<drivers::SyntheticImuSource>(offline(c, 3.0)), c).merged_in_stamp_order);
+  const RunResult live_stamps =
+      run(std::make_unique<drivers::SyntheticImuSource>(offline(c, 3.0)), c, true);
+  EXPECT_FALSE(live_stamps.merged_in_stamp_order);
+  EXPECT_GT(live_stamps.states.size(), 100u);
 }
 
 TEST(Pipeline, CorruptFramesAreCountedAndSkipped) {
