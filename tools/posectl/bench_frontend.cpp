@@ -390,6 +390,7 @@ int bench_frontend() {
     }
     const std::string m(vision::to_string(mode));
     report("frontend", m + "_total_median", quantile_ms(r.timer.totals(), 0.5), "ms");
+    report("frontend", m + "_total_p99", quantile_ms(r.timer.totals(), 0.99), "ms");
     report("frontend", m + "_features_mean", r.features, "features");
     report("frontend", m + "_match_success", r.previous > 0 ? r.inliers / r.previous : 0, "ratio");
     report("frontend", m + "_depth_associated_mean", r.depth, "features");
