@@ -95,6 +95,13 @@ int main(int argc, char** argv) noexcept try {
   app.add_option("--passes", options.replay.max_passes,
                  "with --loop: stop after this many passes (0: until a signal)")
       ->needs(loop);
+  app.add_option("--streams", options.replay.only_streams,
+                 "with --replay: replay only these recorded streams, comma-separated (e.g. "
+                 "imu,lidar for lidar-inertial odometry alone on a four-sensor recording, its "
+                 "images never read); imu must be among them; default: every recorded stream")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"imu", "lidar", "visible", "thermal", "depth", "realsense_imu"}))
+      ->needs(replay);
   app.add_option("--start", options.replay.start_s, "skip this much of the recording [s]")
       ->check(CLI::NonNegativeNumber)
       ->needs(replay);

@@ -72,6 +72,27 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
       out.have_host_to_wall = true;
     }
   }
+  // --streams: the ones asked for, each of them recorded; the rest stay listed, not replayed.
+  std::set<std::string> left_out;
+  if (!options.only_streams.empty()) {
+    const std::set<std::string> wanted(options.only_streams.begin(), options.only_streams.end());
+    for (const std::string& s : wanted) {
+      if (streams.count(s)) continue;
+      std::string found;
+      for (const auto& f : streams) found += (found.empty() ? "" : ", ") + f;
+      error = options.path + ": --streams names " + s + ", which the recording does not have (" +
+              (found.empty() ? std::string("no streams") : found) + ")";
+      return out;
+    }
+    if (!wanted.count("imu")) {
+      error = "--streams must include imu: every estimate starts from the IMU";
+      return out;
+    }
+    for (const std::string& s : streams) {
+      if (!wanted.count(s)) left_out.insert(s);
+    }
+    for (const std::string& s : left_out) streams.erase(s);
+  }
   if (!streams.count("imu")) {
     std::string found;
     for (const auto& s : streams) found += (found.empty() ? "" : ", ") + s;
@@ -142,6 +163,8 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
   }
   if (rsimu_raw) out.built.sources.realsense_imu = make("realsense_imu");
   std::string skipped;
+  for (const auto& s : left_out)
+    out.streams += (out.streams.empty() ? "" : ", ") + s + " (left out by --streams)";
   for (const auto& s : streams) {
     const bool replayed = s == "imu" || s == "lidar" || s == "visible" || s == "thermal" ||
                           (s == "depth" && out.built.sources.depth) ||

@@ -41,6 +41,10 @@ struct ReplayOptions {
   bool recorded_config = false;
   /// replay the D435i's depth stream, if recorded (depth_camera.feature_depth: its only use)
   bool depth = true;
+  /// replay only these recorded streams (posed --streams imu,lidar: lidar-inertial alone on a
+  /// four-sensor recording, without decoding its images); empty: every stream with a stage. The
+  /// IMU must be among them; a stream the recording lacks is an error.
+  std::vector<std::string> only_streams;
 };
 
 struct ReplaySources {
