@@ -451,8 +451,7 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   }
   motions_.clear();
   if (aiding_ != nullptr) {
-    aiding_->set_lidar_weak(lidar_suspect_);
-    aiding_->set_lidar_settled(lidar_settled_);
+    aiding_->set_lidar_state({.weak = lidar_suspect_, .settled = lidar_settled_});
     aiding_->relative_motions(window_, predicted, motions_);
   }
   if (lidar_factor && !motions_.empty() && lidar_suspect_) reconcile(*lidar_factor);

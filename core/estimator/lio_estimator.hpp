@@ -73,7 +73,7 @@ struct LioConfig {
   double aided_suspect_window_s = 5.0;
   /// The lidar is settled once every scan for this long has pinned every direction (none
   /// degenerate or rejected, the window not restarted): the aiding then weighs itself as beside a
-  /// lidar that has fixed the speed and biases (WindowAiding::set_lidar_settled) [s]
+  /// lidar that has fixed the speed and biases (WindowAiding::set_lidar_state) [s]
   double aided_settled_after_s = 5.0;
   /// seed 001's adaptive pose selection of each state's initial value (pose_selection.hpp); off:
   /// the IMU prediction

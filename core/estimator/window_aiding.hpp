@@ -39,12 +39,16 @@ class WindowAiding {
   /// append nothing.
   virtual void relative_motions(const SlidingWindow& window, const imu::ImuState& next,
                                 std::vector<RelativeMotion>& out) = 0;
-  /// Told before each relative_motions whether the lidar has recently been unable to pin a
-  /// direction (a scan with a degenerate direction within `aided_suspect_window_s`).
-  virtual void set_lidar_weak(bool weak) { (void)weak; }
-  /// Told with set_lidar_weak whether the lidar has pinned every direction for
-  /// `aided_settled_after_s` (and so has fixed the speed and biases by itself).
-  virtual void set_lidar_settled(bool settled) { (void)settled; }
+  /// What the lidar has shown lately, told before each relative_motions.
+  struct LidarState {
+    /// unable to pin a direction recently (a scan with a degenerate direction within
+    /// `aided_suspect_window_s`)
+    bool weak = false;
+    /// every direction pinned for `aided_settled_after_s` (so the lidar has fixed the speed and
+    /// biases by itself)
+    bool settled = false;
+  };
+  virtual void set_lidar_state(const LidarState& state) { (void)state; }
   /// Whether it expects to add motions for the next state (e.g. a camera whose images are good
   /// enough): the lidar then leaves its weakly constrained directions to it.
   virtual bool active() const = 0;

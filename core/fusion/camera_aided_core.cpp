@@ -61,14 +61,9 @@ void CameraAidedCore::sync() {
   if (factors_) active_ = factors_->active();
 }
 
-void CameraAidedCore::set_lidar_weak(bool weak) {
+void CameraAidedCore::set_lidar_state(const LidarState& state) {
   sync();
-  factors_->set_lidar_weak(weak);
-}
-
-void CameraAidedCore::set_lidar_settled(bool settled) {
-  sync();
-  factors_->set_lidar_settled(settled);
+  factors_->set_lidar_state(state);
 }
 
 void CameraAidedCore::relative_motions(const estimator::SlidingWindow& window,

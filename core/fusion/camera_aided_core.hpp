@@ -70,8 +70,7 @@ class CameraAidedCore final : public FusionCore,
   // The window's view of the camera back end (CameraFactors), joined with the lane first.
   void relative_motions(const estimator::SlidingWindow& window, const imu::ImuState& next,
                         std::vector<estimator::RelativeMotion>& out) override;
-  void set_lidar_weak(bool weak) override;
-  void set_lidar_settled(bool settled) override;
+  void set_lidar_state(const LidarState& state) override;
   bool active() const override { return active_; }
   std::uint8_t add_factors(estimator::SlidingWindow& window) override;
   void after_solve(const estimator::SlidingWindow& window) override;

@@ -81,7 +81,7 @@ struct CameraFactorsConfig {
   /// features further than this from where the window's prediction puts them are left out of a
   /// frame pair's motion (frame_motion.hpp's guess_gate) [px]
   double guess_gate_px = 3.0;
-  /// the same gate where the lidar has recently been weak (set_lidar_weak): there the window's
+  /// the same gate where the lidar has recently been weak (set_lidar_state): there the window's
   /// speed along the lidar's blind direction is only as good as the cameras made it, and a guess
   /// a quarter off moves a near feature's prediction by more than 3 px; what is left inside a
   /// tight gate are the distant features, which agree with any speed and confirm the guess [px]
@@ -107,8 +107,8 @@ struct CameraFactorsConfig {
   /// independent (tracking errors, depth association, time offsets) [rad], [m]
   double floor_rotation_rad = 0.001;
   double floor_translation_m = 0.002;
-  /// the translation floor where the lidar is strong and settled (set_lidar_weak(false),
-  /// set_lidar_settled(true): no degenerate or rejected scan for aided_settled_after_s): there a
+  /// the translation floor where the lidar is strong and settled (set_lidar_state: not
+  /// weak, settled: no degenerate or rejected scan for aided_settled_after_s): there a
   /// scan pins the motion to millimetres and a frame pair's errors only add noise. 30 mm brings
   /// the mine, room and street_night within about a millimetre of the lidar alone (2 mm leaves
   /// them up to 8 mm worse); applied from the first scan on, it cost the tunnel the speed the
@@ -133,7 +133,7 @@ struct CameraFactorsConfig {
   /// simulated corridor a frame pair's motion along the axis is good to 4 cm at 1 m/s, a random
   /// walk over the hundreds of pairs a minute's drive takes. The keyframe must stay in the
   /// window, so this is at most the window's size less one [states]. Only where the lidar has
-  /// recently been weak (set_lidar_weak): the rotation is the window's, and over a longer
+  /// recently been weak (set_lidar_state): the rotation is the window's, and over a longer
   /// baseline its error moves distant features further; where the lidar pins every direction,
   /// consecutive pairs measured better (street_night seed 11: 0.034 m against 0.047 m).
   int keyframe_states = 5;
@@ -153,8 +153,10 @@ class CameraFactors final : public estimator::WindowAiding {
                         std::vector<estimator::RelativeMotion>& out) override;
   std::uint8_t add_factors(estimator::SlidingWindow& window) override;
   void after_solve(const estimator::SlidingWindow& window) override;
-  void set_lidar_weak(bool weak) override { lidar_weak_ = weak; }
-  void set_lidar_settled(bool settled) override { lidar_settled_ = settled; }
+  void set_lidar_state(const LidarState& state) override {
+    lidar_weak_ = state.weak;
+    lidar_settled_ = state.settled;
+  }
   /// A configured stream's gate is open.
   bool active() const override;
 

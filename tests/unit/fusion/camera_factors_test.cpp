@@ -152,7 +152,7 @@ TEST(CameraFactors, MotionsStartFromAKeyframeForKeyframeStates) {
   EXPECT_EQ(factors.figures()[0].keyframe_factors, 2u);
   // The keyframe at 0.6 s would anchor 0.8 s too; where the lidar pins every direction the
   // motion starts from the previous state instead.
-  factors.set_lidar_weak(false);
+  factors.set_lidar_state({.weak = false});
   std::vector<estimator::RelativeMotion> motions;
   factors.relative_motions(window, state_at(0.8), motions);
   ASSERT_EQ(motions.size(), 1u);
@@ -200,7 +200,7 @@ TEST(CameraFactors, WhereTheLidarIsWeakTheGateKeepsTheNearFeaturesAStaleSpeedMis
   const FactorsWorld world(points);
   const auto measure = [&](bool lidar_weak) {
     CameraFactors factors(factors_config());
-    factors.set_lidar_weak(lidar_weak);
+    factors.set_lidar_state({.weak = lidar_weak});
     for (double t = 0.013; t < 0.5; t += 1.0 / 15)
       factors.add_frame(vision::FrontendMode::kVisible, world.frame(t, 0.9));
     estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
@@ -229,8 +229,7 @@ TEST(CameraFactors, WhereTheLidarIsStrongAFactorSaysNoMoreThanItsTranslationFloo
     CameraFactorsConfig c = factors_config();
     c.strong_lidar_floor_translation_m = 0.03;
     CameraFactors factors(c);
-    factors.set_lidar_weak(lidar_weak);
-    factors.set_lidar_settled(lidar_settled);
+    factors.set_lidar_state({.weak = lidar_weak, .settled = lidar_settled});
     const std::vector<estimator::RelativeMotion> motions = one_motion(factors, world, 0.45);
     EXPECT_EQ(motions.size(), 1u);
     if (motions.empty()) return 0.0;

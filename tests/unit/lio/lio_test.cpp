@@ -185,8 +185,10 @@ class ListeningAiding final : public WindowAiding {
                         std::vector<RelativeMotion>&) override {
     told.push_back({next.stamp, weak_, settled_});
   }
-  void set_lidar_weak(bool weak) override { weak_ = weak; }
-  void set_lidar_settled(bool settled) override { settled_ = settled; }
+  void set_lidar_state(const LidarState& state) override {
+    weak_ = state.weak;
+    settled_ = state.settled;
+  }
   bool active() const override { return false; }
   std::vector<Told> told;
 
