@@ -34,6 +34,7 @@ class LidarHelper final : public WorkSplitter {
   LidarHelper(const LidarHelper&) = delete;
   LidarHelper& operator=(const LidarHelper&) = delete;
 
+  /// One caller at a time (the fusion thread): a job is posted, shared and joined before the next.
   void run(std::size_t parts, const Part& part) override;
   LidarHelperCounters counters() const;
 
