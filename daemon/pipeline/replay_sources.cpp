@@ -28,6 +28,13 @@ bool open_with_channels(const std::string& path, recording::McapReader& reader,
   return true;
 }
 
+/// The recorded streams as a list for messages: "imu, lidar", or "no streams".
+std::string listed(const std::set<std::string>& streams) {
+  std::string out;
+  for (const auto& s : streams) out += (out.empty() ? "" : ", ") + s;
+  return out.empty() ? "no streams" : out;
+}
+
 }  // namespace
 
 bool read_recorded_config(const std::string& path, std::string& yaml, std::string& error) {
@@ -78,10 +85,8 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     const std::set<std::string> wanted(options.only_streams.begin(), options.only_streams.end());
     for (const std::string& s : wanted) {
       if (streams.count(s)) continue;
-      std::string found;
-      for (const auto& f : streams) found += (found.empty() ? "" : ", ") + f;
       error = options.path + ": --streams names " + s + ", which the recording does not have (" +
-              (found.empty() ? std::string("no streams") : found) + ")";
+              listed(streams) + ")";
       return out;
     }
     if (!wanted.count("imu")) {
@@ -94,12 +99,10 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     for (const std::string& s : left_out) streams.erase(s);
   }
   if (!streams.count("imu")) {
-    std::string found;
-    for (const auto& s : streams) found += (found.empty() ? "" : ", ") + s;
     error = options.path +
             ": no IMU stream to replay (/posed/raw/imu, or an imported topic mapped to imu: "
             "posectl import --topic-map TOPIC=imu); found: " +
-            (found.empty() ? std::string("no streams") : found);
+            listed(streams);
     return out;
   }
 
