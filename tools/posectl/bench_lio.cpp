@@ -16,6 +16,7 @@
 #include "daemon/pipeline/estimator_config.hpp"
 #include "daemon/pipeline/lidar_helper.hpp"
 #include "drivers/velodyne/scan_builder.hpp"
+#include "tools/eval/umeyama.hpp"
 #include "tools/posectl/bench.hpp"
 #include "tools/sim/lidar_imu_run.hpp"
 #include "tools/sim/rig_config.hpp"
@@ -99,27 +100,18 @@ void run_estimator(const config::PosedConfig& config, const sim::LidarImuRun& ru
 
 /// ATE RMSE of the optimised poses after the best rigid alignment [m].
 double ate_rmse(const std::vector<NavState>& states, const sim::LidarImuRun& run) {
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs;
+  std::vector<Eigen::Vector3d> p_est, p_gt;
   for (const NavState& s : states) {
-    if (s.optimised) pairs.emplace_back(s.p_map_base_m, run.T_map_base(s.stamp).translation());
+    if (!s.optimised) continue;
+    p_est.push_back(s.p_map_base_m);
+    p_gt.push_back(run.T_map_base(s.stamp).translation());
   }
-  Eigen::Vector3d me = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
-  for (const auto& [e, g] : pairs) {
-    me += e;
-    mg += g;
-  }
-  const double n = std::max<double>(1.0, static_cast<double>(pairs.size()));
-  me /= n;
-  mg /= n;
-  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-  for (const auto& [e, g] : pairs) C += (g - mg) * (e - me).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
-  const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
+  const eval::Sim3 aligned = eval::umeyama(p_est, p_gt, false);
   double sq = 0;
-  for (const auto& [e, g] : pairs) sq += (R * (e - me) + mg - g).squaredNorm();
-  return std::sqrt(sq / n);
+  for (std::size_t i = 0; i < p_est.size(); ++i) {
+    sq += (aligned.apply(p_est[i]) - p_gt[i]).squaredNorm();
+  }
+  return std::sqrt(sq / static_cast<double>(p_est.size()));
 }
 
 bool same_poses(const std::vector<NavState>& a, const std::vector<NavState>& b) {
