@@ -15,6 +15,11 @@ namespace raw = drivers::recording::raw;
 
 namespace {
 
+/// How far a paced replay reads ahead of what it delivered: longer than any stall of a reader
+/// at normal priority behind the real-time stages (a scan's 6-8 ms), short enough that the
+/// frames held stay a few MB (4 visible frames at 25 Hz).
+constexpr Duration kPacedReadAhead = Duration::from_ns(150'000'000);
+
 /// Opens a recording with its channels and metadata known: they come from the summary, and a
 /// file cut short has none, so it is scanned to the damage.
 bool open_with_channels(const std::string& path, recording::McapReader& reader,
@@ -124,6 +129,10 @@ ReplaySources make_replay_sources(const ReplayOptions& options, std::string& err
     c.time_shift = options.time_shift;
     c.live_timeline = timeline;
     c.chunk_cache = chunks;
+    // Paced replays read the file on threads of their own, so a stage waits only for the
+    // message to be due, as it would for its device (mcap_replay_source.hpp). At --max-speed
+    // the stages are the pace and read for themselves: no extra threads, no copies.
+    if (c.rate > 0 || timeline) c.read_ahead = kPacedReadAhead;
     auto source = std::make_unique<recording::McapReplaySource>(std::move(c));
     out.replayers.push_back(source.get());
     return source;

@@ -1,5 +1,9 @@
 #include "drivers/recording/mcap_replay_source.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <optional>
@@ -11,12 +15,34 @@
 
 namespace posed::drivers::recording {
 
-namespace {}  // namespace
+namespace {
+
+/// The calling thread at normal priority on every CPU, whatever the thread that started it ran
+/// at (a new thread inherits its creator's policy and affinity): reading ahead must never take a
+/// core from a real-time stage, nor wait for one pinned elsewhere.
+void run_as_background_thread(const std::string& name) {
+  sched_param normal{};
+  normal.sched_priority = 0;
+  pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  for (long cpu = 0; cpu < cpus && cpu < CPU_SETSIZE; ++cpu) CPU_SET(static_cast<int>(cpu), &all);
+  pthread_setaffinity_np(pthread_self(), sizeof all, &all);
+  pthread_setname_np(pthread_self(), name.substr(0, 15).c_str());
+}
+
+}  // namespace
 
 McapReplaySource::McapReplaySource(McapReplayConfig config)
     : config_(std::move(config)),
       name_(config_.name.empty() ? config_.stream : config_.name),
       loop_shift_ns_(config_.time_shift.ns) {}
+
+McapReplaySource::~McapReplaySource() {
+  request_stop();
+  if (reader_thread_.joinable()) reader_thread_.join();
+}
 
 bool McapReplaySource::wanted(const McapChannelRecord& c) const {
   return raw::is_stream_channel(c.message_encoding, c.metadata) &&
@@ -52,7 +78,95 @@ bool McapReplaySource::open(std::string& error) {
     }
   }
   opened_ = true;
+  if (config_.read_ahead.ns > 0) {
+    ahead_ = std::make_unique<SpscQueue<AheadMessage>>(kReadAheadMessages, DropPolicy::kDropNewest);
+    reader_thread_ = std::thread([this] { read_ahead_loop(); });
+  }
   return true;
+}
+
+std::uint32_t McapReplaySource::source_channel_of(std::uint16_t channel_id) {
+  std::lock_guard lock(info_mutex_);
+  return channels_[channel_id].source_channel;
+}
+
+// The two threads wake each other only when the other waits, and the reader waits for half the
+// window at a time: a replay of 1500 lidar packets a second then costs its reader a dozen wake-ups
+// a second, not one per packet, and read() a system call only when it found nothing to take.
+// Each side announces its wait (an atomic), then checks again before sleeping; the other side
+// checks the announcement after its own store. Fences on both sides order the two (Dekker's
+// pattern), so one of them always sees the other and no wake-up is lost or left over.
+
+void McapReplaySource::read_ahead_loop() {
+  run_as_background_thread("posed-rd-" + name_);
+  const std::int64_t window_ns = config_.read_ahead.ns;
+  bool first = true;
+  while (!stop_.load(std::memory_order_relaxed) && fetch()) {
+    AheadMessage m;
+    m.bytes.assign(pending_.data.begin(), pending_.data.end());
+    m.source_channel = source_channel_of(pending_.channel->id);
+    m.log_ns = pending_log_ns_;
+    have_pending_ = false;
+    if (first) {
+      // Until read() takes one, the window starts at the first message.
+      ahead_base_log_ns_.store(m.log_ns, std::memory_order_seq_cst);
+      first = false;
+    }
+    // Room: under the message cap, and within the window of the newest message read() took.
+    while (!stop_.load(std::memory_order_relaxed)) {
+      const bool under_cap = ahead_->size() < ahead_->capacity();
+      if (under_cap && m.log_ns - ahead_base_log_ns_.load() <= window_ns) break;
+      // Wait for read() to take half the window (a full queue is polled every 20 ms).
+      const std::int64_t wake_at = m.log_ns - window_ns / 2;
+      ahead_wake_reader_at_ns_.store(wake_at);
+      std::atomic_thread_fence(std::memory_order_seq_cst);
+      bool woken = false;
+      if (!under_cap || ahead_base_log_ns_.load() < wake_at) {
+        woken = ahead_room_.try_acquire_for(std::chrono::milliseconds(20));
+      }
+      // read() took the announcement, so its release is on the way, if not consumed: consume it.
+      if (ahead_wake_reader_at_ns_.exchange(kNoWake) == kNoWake && !woken) ahead_room_.acquire();
+    }
+    if (stop_.load(std::memory_order_relaxed)) break;
+    ahead_->push(std::move(m));
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    if (ahead_consumer_waiting_.exchange(false)) ahead_filled_.release();
+  }
+  ahead_ended_.store(true);
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  if (ahead_consumer_waiting_.exchange(false)) ahead_filled_.release();
+}
+
+bool McapReplaySource::take_ahead(Duration timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::nanoseconds(timeout.ns);
+  for (;;) {
+    // Read before the pop: ended and then empty means nothing more will come.
+    const bool ended = ahead_ended_.load();
+    if (ahead_->try_pop(current_)) {
+      ahead_base_log_ns_.store(current_.log_ns);
+      std::atomic_thread_fence(std::memory_order_seq_cst);
+      std::int64_t wake_at = ahead_wake_reader_at_ns_.load();
+      if (wake_at != kNoWake && current_.log_ns >= wake_at &&
+          ahead_wake_reader_at_ns_.compare_exchange_strong(wake_at, kNoWake)) {
+        ahead_room_.release();
+      }
+      have_current_ = true;
+      return true;
+    }
+    if (ended) {
+      ended_ = true;
+      return false;
+    }
+    if (stop_.load(std::memory_order_relaxed)) return false;
+    const auto left = deadline - std::chrono::steady_clock::now();
+    if (left <= std::chrono::nanoseconds(0)) return false;
+    ahead_consumer_waiting_.store(true);
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    bool woken = false;
+    if (ahead_->empty() && !ahead_ended_.load()) woken = ahead_filled_.try_acquire_for(left);
+    // The reader took the announcement, so its release is on the way, if not consumed: consume it.
+    if (!ahead_consumer_waiting_.exchange(false) && !woken) ahead_filled_.acquire();
+  }
 }
 
 void McapReplaySource::note_damage() {
@@ -80,7 +194,7 @@ bool McapReplaySource::fetch() {
     const std::int64_t gap = std::max<std::int64_t>(1, last_log_ns_ - prev_log_ns_);
     loop_shift_ns_ += (last_log_ns_ - first_log_ns_ - config_.start_offset.ns) + gap;
     reader_.rewind();
-    ++passes_;
+    passes_.fetch_add(1, std::memory_order_relaxed);
     delivered_this_pass_ = 0;
     return true;
   };
@@ -126,27 +240,37 @@ bool McapReplaySource::fetch() {
 
 ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
   if (!opened_ || stop_.load(std::memory_order_relaxed)) return ReadStatus::kEndOfStream;
-  if (!have_pending_) {
-    if (ended_ || !fetch()) {
-      ended_ = true;
-      return ReadStatus::kEndOfStream;
+  std::int64_t log_ns = 0;
+  if (ahead_) {
+    if (!have_current_ && (ended_ || !take_ahead(timeout))) {
+      return ended_ || stop_.load(std::memory_order_relaxed) ? ReadStatus::kEndOfStream
+                                                             : ReadStatus::kTimeout;
     }
+    log_ns = current_.log_ns;
+  } else {
+    if (!have_pending_) {
+      if (ended_ || !fetch()) {
+        ended_ = true;
+        return ReadStatus::kEndOfStream;
+      }
+    }
+    log_ns = pending_log_ns_;
   }
-  // When the pending message is due on the host clock (recorded timing, scaled by the rate, or
-  // one shift shared by every stream with live stamps); none at full speed.
-  std::int64_t receive_ns = pending_log_ns_;
+  // When the message is due on the host clock (recorded timing, scaled by the rate, or one shift
+  // shared by every stream with live stamps); none at full speed.
+  std::int64_t receive_ns = log_ns;
   std::optional<HostTime> due;
   if (config_.live_timeline) {
-    receive_ns += config_.live_timeline->shift(pending_log_ns_, host_now()).ns;
+    receive_ns += config_.live_timeline->shift(log_ns, host_now()).ns;
     due = HostTime::from_ns(receive_ns);
   } else if (config_.rate > 0) {
     if (!paced_) {
       paced_ = true;
       anchor_host_ = host_now();
-      anchor_log_ns_ = pending_log_ns_;
+      anchor_log_ns_ = log_ns;
     }
-    const auto offset_ns = static_cast<std::int64_t>(
-        static_cast<double>(pending_log_ns_ - anchor_log_ns_) / config_.rate);
+    const auto offset_ns =
+        static_cast<std::int64_t>(static_cast<double>(log_ns - anchor_log_ns_) / config_.rate);
     due = anchor_host_ + Duration::from_ns(offset_ns);
   }
   if (due && *due > host_now()) {
@@ -157,19 +281,25 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
     if (stop_.load(std::memory_order_relaxed)) return ReadStatus::kEndOfStream;
     if (host_now() < *due) return ReadStatus::kTimeout;
   }
-  chunk.bytes = pending_.data;
   chunk.host_receive = HostTime::from_ns(receive_ns);
-  {
-    std::lock_guard lock(info_mutex_);
-    chunk.channel = channels_[pending_.channel->id].source_channel;
+  if (ahead_) {
+    // No lock here: the reader thread holds info_mutex_ at normal priority.
+    chunk.bytes = current_.bytes;
+    chunk.channel = current_.source_channel;
+    have_current_ = false;
+  } else {
+    chunk.bytes = pending_.data;
+    chunk.channel = source_channel_of(pending_.channel->id);
+    have_pending_ = false;
   }
-  have_pending_ = false;
   counts_.count_chunk(chunk.bytes.size());
   return ReadStatus::kData;
 }
 
 void McapReplaySource::request_stop() {
   stop_.store(true, std::memory_order_relaxed);
+  ahead_room_.release();
+  ahead_filled_.release();
   std::lock_guard lock(wait_mutex_);
   wait_cv_.notify_all();
 }

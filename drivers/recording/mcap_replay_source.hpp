@@ -10,16 +10,27 @@
 //
 // A recording cut short replays up to the damage, then ends; the damage is logged once and kept
 // in damage().
+//
+// Paced replays can read ahead (McapReplayConfig::read_ahead): a thread of its own, at normal
+// priority, reads, decompresses and CRC-checks the file up to that much log time ahead of what
+// was delivered, so read() only waits for the message to be due and hands it over. On the robot
+// the IMU's thread does nothing but read its serial port and publish odometry; without this, a
+// replay's IMU thread also decompressed other streams' chunks and folded the file's CRC, 4-7 ms
+// at a time, and that showed as odometry latency that no robot has (docs/realtime.md).
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <semaphore>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "core/spsc_queue.hpp"
 #include "drivers/common/source.hpp"
 #include "drivers/recording/mcap_reader.hpp"
 
@@ -72,6 +83,9 @@ struct McapReplayConfig {
   std::shared_ptr<ReplayTimeline> live_timeline;
   /// shared by the replay's Sources: a chunk one stream decompressed, the others read from memory
   std::shared_ptr<McapChunkCache> chunk_cache;
+  /// > 0: a thread of the Source's own reads the stream this far (log time) ahead of read(), at
+  /// most kReadAheadMessages messages; 0: read() reads the file itself
+  Duration read_ahead = Duration::from_ns(0);
 };
 
 /// One raw channel of the stream, as recorded.
@@ -85,11 +99,17 @@ struct ReplayChannel {
 
 class McapReplaySource final : public Source {
  public:
+  /// The most messages read ahead at once (McapReplayConfig::read_ahead), whatever their span.
+  static constexpr std::size_t kReadAheadMessages = 1024;
+
   explicit McapReplaySource(McapReplayConfig config);
+  ~McapReplaySource() override;
+  McapReplaySource(const McapReplaySource&) = delete;
+  McapReplaySource& operator=(const McapReplaySource&) = delete;
 
   std::string_view name() const override { return name_; }
   /// Opens the file; fails when it is not MCAP, or when its summary lists no raw channel of the
-  /// stream (the error names the streams it does hold).
+  /// stream (the error names the streams it does hold). Starts the read-ahead thread, if any.
   bool open(std::string& error) override;
   ReadStatus read(RawChunk& chunk, Duration timeout) override;
   void request_stop() override;
@@ -103,7 +123,7 @@ class McapReplaySource final : public Source {
   /// "" or where and why the recording ended early.
   std::string damage() const;
   /// completed passes over the recording (loop)
-  std::uint64_t passes() const { return passes_; }
+  std::uint64_t passes() const { return passes_.load(std::memory_order_relaxed); }
 
   /// What the current (or last) pass delivered, in recorded log time (time_shift not added).
   struct DeliveredSpan {
@@ -113,11 +133,24 @@ class McapReplaySource final : public Source {
     /// between the last two messages (0 with fewer than two)
     std::int64_t last_gap_ns = 0;
   };
-  /// Call when the Source is not being read (after the pipeline joined).
+  /// Call when the Source is not being read (after the pipeline joined). With read-ahead, what
+  /// was read from the file: the same once the stream has ended.
   DeliveredSpan delivered_span() const;
 
  private:
+  /// One message read ahead: its bytes copied out of the reader's chunk.
+  struct AheadMessage {
+    std::vector<std::byte> bytes;
+    std::uint32_t source_channel = 0;
+    std::int64_t log_ns = 0;  // shifted by the loop offset
+  };
+
   bool fetch();  // the next message of the stream into pending_, applying offset/duration/loop
+  std::uint32_t source_channel_of(std::uint16_t channel_id);
+  void read_ahead_loop();
+  /// read() with read-ahead: the next message into current_; false at the end (ended_ set) or
+  /// when none came within `timeout`.
+  bool take_ahead(Duration timeout);
   bool wanted(const McapChannelRecord& c) const;
   void note_damage();
 
@@ -136,8 +169,21 @@ class McapReplaySource final : public Source {
   std::int64_t last_log_ns_ = 0, prev_log_ns_ = 0;
   std::int64_t pass_first_log_ns_ = 0;  // the first message delivered in this pass
   std::int64_t loop_shift_ns_ = 0;
-  std::uint64_t passes_ = 0;
+  std::atomic<std::uint64_t> passes_{0};
   std::uint64_t delivered_this_pass_ = 0;
+
+  // read-ahead: the reader thread fills ahead_, read() empties it into current_
+  std::unique_ptr<SpscQueue<AheadMessage>> ahead_;
+  std::atomic<bool> ahead_ended_{false};
+  std::atomic<std::int64_t> ahead_base_log_ns_{0};  // log time of the newest message taken
+  static constexpr std::int64_t kNoWake = std::numeric_limits<std::int64_t>::min();
+  // the reader waits until read() takes a message this late (kNoWake: it does not wait)
+  std::atomic<std::int64_t> ahead_wake_reader_at_ns_{kNoWake};
+  std::atomic<bool> ahead_consumer_waiting_{false};  // read() waits for a message
+  std::counting_semaphore<1 << 30> ahead_filled_{0}, ahead_room_{0};
+  AheadMessage current_;
+  bool have_current_ = false;
+  std::thread reader_thread_;
 
   bool paced_ = false;
   HostTime anchor_host_;
