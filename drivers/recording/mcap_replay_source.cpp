@@ -94,8 +94,9 @@ std::uint32_t McapReplaySource::source_channel_of(std::uint16_t channel_id) {
 // window at a time: a replay of 1500 lidar packets a second then costs its reader a dozen wake-ups
 // a second, not one per packet, and read() a system call only when it found nothing to take.
 // Each side announces its wait (an atomic), then checks again before sleeping; the other side
-// checks the announcement after its own store. Fences on both sides order the two (Dekker's
-// pattern), so one of them always sees the other and no wake-up is lost or left over.
+// checks the announcement after its own store. Every one of these operations is sequentially
+// consistent, so of the two store-then-load pairs one always sees the other (Dekker's pattern):
+// no wake-up is lost or left over. (Not fences: ThreadSanitizer does not model them.)
 
 void McapReplaySource::read_ahead_loop() {
   run_as_background_thread("posed-rd-" + name_);
@@ -119,7 +120,6 @@ void McapReplaySource::read_ahead_loop() {
       // Wait for read() to take half the window (a full queue is polled every 20 ms).
       const std::int64_t wake_at = m.log_ns - window_ns / 2;
       ahead_wake_reader_at_ns_.store(wake_at);
-      std::atomic_thread_fence(std::memory_order_seq_cst);
       bool woken = false;
       if (!under_cap || ahead_base_log_ns_.load() < wake_at) {
         woken = ahead_room_.try_acquire_for(std::chrono::milliseconds(20));
@@ -129,11 +129,10 @@ void McapReplaySource::read_ahead_loop() {
     }
     if (stop_.load(std::memory_order_relaxed)) break;
     ahead_->push(std::move(m));
-    std::atomic_thread_fence(std::memory_order_seq_cst);
+    ahead_pushed_.fetch_add(1);
     if (ahead_consumer_waiting_.exchange(false)) ahead_filled_.release();
   }
   ahead_ended_.store(true);
-  std::atomic_thread_fence(std::memory_order_seq_cst);
   if (ahead_consumer_waiting_.exchange(false)) ahead_filled_.release();
 }
 
@@ -143,8 +142,8 @@ bool McapReplaySource::take_ahead(Duration timeout) {
     // Read before the pop: ended and then empty means nothing more will come.
     const bool ended = ahead_ended_.load();
     if (ahead_->try_pop(current_)) {
+      ++ahead_taken_;
       ahead_base_log_ns_.store(current_.log_ns);
-      std::atomic_thread_fence(std::memory_order_seq_cst);
       std::int64_t wake_at = ahead_wake_reader_at_ns_.load();
       if (wake_at != kNoWake && current_.log_ns >= wake_at &&
           ahead_wake_reader_at_ns_.compare_exchange_strong(wake_at, kNoWake)) {
@@ -161,9 +160,10 @@ bool McapReplaySource::take_ahead(Duration timeout) {
     const auto left = deadline - std::chrono::steady_clock::now();
     if (left <= std::chrono::nanoseconds(0)) return false;
     ahead_consumer_waiting_.store(true);
-    std::atomic_thread_fence(std::memory_order_seq_cst);
     bool woken = false;
-    if (ahead_->empty() && !ahead_ended_.load()) woken = ahead_filled_.try_acquire_for(left);
+    if (ahead_pushed_.load() == ahead_taken_ && !ahead_ended_.load()) {
+      woken = ahead_filled_.try_acquire_for(left);
+    }
     // The reader took the announcement, so its release is on the way, if not consumed: consume it.
     if (!ahead_consumer_waiting_.exchange(false) && !woken) ahead_filled_.acquire();
   }

@@ -180,6 +180,8 @@ class McapReplaySource final : public Source {
   // the reader waits until read() takes a message this late (kNoWake: it does not wait)
   std::atomic<std::int64_t> ahead_wake_reader_at_ns_{kNoWake};
   std::atomic<bool> ahead_consumer_waiting_{false};  // read() waits for a message
+  std::atomic<std::uint64_t> ahead_pushed_{0};       // messages the reader queued
+  std::uint64_t ahead_taken_ = 0;                    // messages read() took (read()'s own)
   std::counting_semaphore<1 << 30> ahead_filled_{0}, ahead_room_{0};
   AheadMessage current_;
   bool have_current_ = false;

@@ -26,6 +26,7 @@
 #include "tests/common/ros1_bag_writer.hpp"
 #include "tests/common/ros1_serialize.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 #include "tests/replay/recorded_poses.hpp"
 #include "tools/eval/evaluation.hpp"
 
@@ -214,11 +215,9 @@ TEST(BagReplay, ASimulatedDriveImportedFromARos1BagIsTrackedInTheBagsTimeBase) {
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "15", "--seed", "8",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim =
+        simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"});
+    ASSERT_TRUE(sim.ok);
   }
   const config::LoadResult loaded = config::load_config_file(source_dir() + "/config/posed.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.error_text();

@@ -16,6 +16,7 @@
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 #include "tests/replay/recorded_poses.hpp"
 #include "tools/eval/umeyama.hpp"
 
@@ -73,10 +74,8 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
   TempDir dir;
   const std::string recording = dir.file("tunnel.mcap");
   {
-    PosedProcess sim({simulator(), "sim", "--scenario", "tunnel", "--duration", "30", "--seed", "4",
-                      "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-                     {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(300s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, recording, "tunnel", 30, 4, {}, 300s);
+    ASSERT_TRUE(sim.ok);
   }
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   const Replay a = replay(dir, recording, "visible", "a");

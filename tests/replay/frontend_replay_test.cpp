@@ -10,6 +10,7 @@
 #include <string>
 
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 
 namespace posed::testing {
 namespace frontend_replay_test {
@@ -25,10 +26,8 @@ TEST(FrontendReplay, ANightDriveRunsTheThreeModesOnTheSameFramesAndPosedReportsT
   const std::string recording = dir.file("night.mcap");
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   {
-    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "8", "--seed",
-                      "4", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-                     {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(180s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, recording, "street_night", 8, 4, {}, 180s);
+    ASSERT_TRUE(sim.ok);
   }
   const std::string frames = dir.file("frames");
   PosedProcess inspect(

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 #include "tests/replay/recorded_poses.hpp"
 #include "tools/eval/umeyama.hpp"
 
@@ -70,13 +71,11 @@ TEST(ImuFailoverReplay, TheD435iImuCarriesTheEstimateThroughAnA9GapAndHandsBack)
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "12", "--seed", "8",
-         "--no-cameras", "--realsense-imu", "--config", source_dir() + "/config/posed.yaml", "-o",
-         recording, "--fault", "imu_gap@5+3"},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
-    EXPECT_NE(sim.out().find("D435i IMU"), std::string::npos) << sim.out();
+    const Simulated sim =
+        simulate_recording(dir, recording, "street_night", 12, 8,
+                           {"--no-cameras", "--realsense-imu", "--fault", "imu_gap@5+3"});
+    ASSERT_TRUE(sim.ok);
+    EXPECT_NE(sim.out.find("D435i IMU"), std::string::npos) << sim.out;
   }
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   ASSERT_FALSE(truth.empty());
@@ -132,12 +131,10 @@ TEST(ImuFailoverReplay, TheD435isOwnNoiseAndBiasCarryTheOdometryWhenTheLidarIsOu
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "12", "--seed", "9",
-         "--no-cameras", "--realsense-imu", "--config", source_dir() + "/config/posed.yaml", "-o",
-         recording, "--fault", "imu_gap@5+4", "--fault", "lidar_outage@6+2"},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, recording, "street_night", 12, 9,
+                                             {"--no-cameras", "--realsense-imu", "--fault",
+                                              "imu_gap@5+4", "--fault", "lidar_outage@6+2"});
+    ASSERT_TRUE(sim.ok);
   }
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   ASSERT_FALSE(truth.empty());

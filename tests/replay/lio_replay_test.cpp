@@ -16,6 +16,7 @@
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 #include "tests/replay/recorded_poses.hpp"
 
 namespace posed::testing {
@@ -36,11 +37,9 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "15", "--seed", "8",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim =
+        simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"});
+    ASSERT_TRUE(sim.ok);
   }
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
@@ -124,11 +123,9 @@ TEST(LioReplay, EveryLoopPassStartsAfreshAndRepeatsTheFirst) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "6", "--seed", "8",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim =
+        simulate_recording(dir, recording, "street_night", 6, 8, {"--no-cameras"});
+    ASSERT_TRUE(sim.ok);
   }
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
@@ -173,12 +170,10 @@ TEST(LioReplay, ALidarOutageIsReportedInTheDataTimeAndTheOdometryCarriesOnThroug
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "8", "--seed",
-                      "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
-                      recording, "--fault", "lidar_outage@4+2"},
-                     {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
-    EXPECT_NE(sim.out().find("fault lidar_outage@4+2"), std::string::npos) << sim.out();
+    const Simulated sim = simulate_recording(dir, recording, "street_night", 8, 8,
+                                             {"--no-cameras", "--fault", "lidar_outage@4+2"});
+    ASSERT_TRUE(sim.ok);
+    EXPECT_NE(sim.out.find("fault lidar_outage@4+2"), std::string::npos) << sim.out;
   }
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
@@ -222,11 +217,9 @@ TEST(LioReplay, ABurstOfCorruptLidarPacketsDoesNotStopTheLidar) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim({simulator(), "sim", "--scenario", "street_night", "--duration", "8", "--seed",
-                      "8", "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o",
-                      recording, "--fault", "corrupt_burst@4+1"},
-                     {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, recording, "street_night", 8, 8,
+                                             {"--no-cameras", "--fault", "corrupt_burst@4+1"});
+    ASSERT_TRUE(sim.ok);
   }
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
@@ -276,12 +269,9 @@ TEST(LioReplay, PosectlExportPcdWritesTheMapAndItsKeyframesDeterministically) {
   const std::string recording = dir.file("street.mcap");
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "12", "--seed", "9",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording, "--gt",
-         dir.file("truth.txt")},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, recording, "street_night", 12, 9,
+                                             {"--no-cameras", "--gt", dir.file("truth.txt")});
+    ASSERT_TRUE(sim.ok);
   }
   for (const char* name : {"a.pcd", "b.pcd"}) {
     PosedProcess exporter({posectl, "export", recording, "--pcd", dir.file(name), "--config",

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 #include "tests/replay/recorded_poses.hpp"
 
 namespace posed::testing {
@@ -30,11 +31,8 @@ TEST(LoopClosureReplay, ARoomsLapsCloseLoopsIdenticallyOnEveryReplayAndLeaveOdom
   TempDir dir;
   const std::string recording = dir.file("room.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "room", "--duration", "50", "--seed", "3",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(180s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, recording, "room", 50, 3, {"--no-cameras"}, 180s);
+    ASSERT_TRUE(sim.ok);
   }
   const std::string dds = "dds:\n  domain_id: " + std::to_string(test_domain()) +
                           "\n  cyclonedds_config: " + source_dir() +

@@ -20,6 +20,7 @@
 #include "daemon/pipeline/replay_sources.hpp"
 #include "drivers/common/host_clock.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 
 namespace posed::testing {
 namespace odometry_stall_replay_test {
@@ -65,11 +66,9 @@ TEST(OdometryStallReplay, OdomKeepsFlowingWhileTheLidarStageIsStalledAndTheWatch
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "9", "--seed", "3",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim =
+        simulate_recording(dir, recording, "street_night", 9, 3, {"--no-cameras"});
+    ASSERT_TRUE(sim.ok);
   }
   config::LoadResult loaded = config::load_config_file(source_dir() + "/config/posed.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.error_text();

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 
 namespace posed::testing {
 // Named rather than anonymous: test binaries build as unity batches.
@@ -35,12 +36,10 @@ TEST(SimCamerasReplay, DepthAndRawThermalDecodeAndTheDepthImageGivesFeaturesDept
   const std::string recording = dir.file("cameras.mcap");
   int visible_frames = 0, thermal_frames = 0, depth_frames = 0;
   {
-    PosedProcess sim({simulator(), "sim", "--scenario", "room", "--duration", "3", "--seed", "3",
-                      "--depth", "--thermal-format", "y16", "--config",
-                      source_dir() + "/config/posed.yaml", "-o", recording},
-                     {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
-    const std::string out = sim.out();
+    const Simulated sim =
+        simulate_recording(dir, recording, "room", 3, 3, {"--depth", "--thermal-format", "y16"});
+    ASSERT_TRUE(sim.ok);
+    const std::string out = sim.out;
     std::smatch m;
     ASSERT_TRUE(std::regex_search(
         out, m,
@@ -116,10 +115,8 @@ TEST(SimCamerasReplay, TheSameSeedWritesTheSameFileByteForByte) {
   std::string files[2];
   for (int i = 0; i < 2; ++i) {
     const std::string path = dir.file("run" + std::to_string(i) + ".mcap");
-    PosedProcess sim({simulator(), "sim", "--scenario", "room", "--duration", "2", "--seed", "11",
-                      "--depth", "--config", source_dir() + "/config/posed.yaml", "-o", path},
-                     {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim = simulate_recording(dir, path, "room", 2, 11, {"--depth"});
+    ASSERT_TRUE(sim.ok);
     files[i] = slurp_file(path);
   }
   ASSERT_GT(files[0].size(), 10'000'000u);  // every sensor, chunked and indexed

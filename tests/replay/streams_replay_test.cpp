@@ -10,6 +10,7 @@
 #include "daemon/pipeline/replay_sources.hpp"
 #include "tests/integration/hil_helpers.hpp"
 #include "tests/integration/posed_process.hpp"
+#include "tests/integration/simulated_recording.hpp"
 
 namespace posed::testing {
 namespace streams_replay_test {
@@ -20,11 +21,9 @@ TEST(StreamsReplay, OnlyTheNamedStreamsAreReplayedAndAMissingOneIsRefused) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   {
-    PosedProcess sim(
-        {simulator(), "sim", "--scenario", "street_night", "--duration", "4", "--seed", "5",
-         "--no-cameras", "--config", source_dir() + "/config/posed.yaml", "-o", recording},
-        {}, dir);
-    ASSERT_EQ(sim.wait_for_exit(120s), 0) << sim.err();
+    const Simulated sim =
+        simulate_recording(dir, recording, "street_night", 4, 5, {"--no-cameras"});
+    ASSERT_TRUE(sim.ok);
   }
   pipeline::ReplayOptions options;
   options.path = recording;
