@@ -85,11 +85,6 @@ bool McapReplaySource::open(std::string& error) {
   return true;
 }
 
-std::uint32_t McapReplaySource::source_channel_of(std::uint16_t channel_id) {
-  std::lock_guard lock(info_mutex_);
-  return channels_[channel_id].source_channel;
-}
-
 // The two threads wake each other only when the other waits, and the reader waits for half the
 // window at a time: a replay of 1500 lidar packets a second then costs its reader a dozen wake-ups
 // a second, not one per packet, and read() a system call only when it found nothing to take.
@@ -105,7 +100,7 @@ void McapReplaySource::read_ahead_loop() {
   while (!stop_.load(std::memory_order_relaxed) && fetch()) {
     AheadMessage m;
     m.bytes.assign(pending_.data.begin(), pending_.data.end());
-    m.source_channel = source_channel_of(pending_.channel->id);
+    m.source_channel = pending_source_channel_;
     m.log_ns = pending_log_ns_;
     have_pending_ = false;
     if (first) {
@@ -207,14 +202,22 @@ bool McapReplaySource::fetch() {
     if (!wanted(*m.channel)) continue;
     const auto id = m.channel->id;
     {
+      // The channel's record, made the first time it is seen; its source channel goes with the
+      // message, so delivering it takes no second look (nor, with read-ahead, this lock).
       std::lock_guard lock(info_mutex_);
-      if (channels_.find(id) == channels_.end()) {
-        channels_[id] = {raw::parse_source_channel(
-                             raw::metadata_value(m.channel->metadata, raw::kSourceChannelKey)),
-                         m.channel->topic,
-                         raw::metadata_value(m.channel->metadata, raw::kWireFormatKey),
-                         m.channel->metadata};
+      auto it = channels_.find(id);
+      if (it == channels_.end()) {
+        it =
+            channels_
+                .emplace(
+                    id, ReplayChannel{raw::parse_source_channel(raw::metadata_value(
+                                          m.channel->metadata, raw::kSourceChannelKey)),
+                                      m.channel->topic,
+                                      raw::metadata_value(m.channel->metadata, raw::kWireFormatKey),
+                                      m.channel->metadata})
+                .first;
       }
+      pending_source_channel_ = it->second.source_channel;
     }
     const auto log = static_cast<std::int64_t>(m.log_time_ns);
     if (!have_first_) {
@@ -289,7 +292,7 @@ ReadStatus McapReplaySource::read(RawChunk& chunk, Duration timeout) {
     have_current_ = false;
   } else {
     chunk.bytes = pending_.data;
-    chunk.channel = source_channel_of(pending_.channel->id);
+    chunk.channel = pending_source_channel_;
     have_pending_ = false;
   }
   counts_.count_chunk(chunk.bytes.size());

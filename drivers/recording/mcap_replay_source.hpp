@@ -146,7 +146,6 @@ class McapReplaySource final : public Source {
   };
 
   bool fetch();  // the next message of the stream into pending_, applying offset/duration/loop
-  std::uint32_t source_channel_of(std::uint16_t channel_id);
   void read_ahead_loop();
   /// read() with read-ahead: the next message into current_; false at the end (ended_ set) or
   /// when none came within `timeout`.
@@ -162,7 +161,8 @@ class McapReplaySource final : public Source {
 
   bool have_pending_ = false;
   McapMessage pending_;
-  std::int64_t pending_log_ns_ = 0;  // shifted by the loop offset
+  std::int64_t pending_log_ns_ = 0;           // shifted by the loop offset
+  std::uint32_t pending_source_channel_ = 0;  // its channel's posed.source_channel
 
   bool have_first_ = false;
   std::int64_t first_log_ns_ = 0;  // the stream's first message in the file

@@ -214,11 +214,7 @@ TEST(BagReplay, ASimulatedDriveImportedFromARos1BagIsTrackedInTheBagsTimeBase) {
   TempDir dir;
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
   const std::string recording = dir.file("street.mcap");
-  {
-    const Simulated sim =
-        simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"});
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"}).ok);
   const config::LoadResult loaded = config::load_config_file(source_dir() + "/config/posed.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.error_text();
   auto converter = std::make_unique<BagFromSimulation>(loaded.config);

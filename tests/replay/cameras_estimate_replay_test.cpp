@@ -73,10 +73,7 @@ Replay replay(TempDir& dir, const std::string& recording, const std::string& mod
 TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
   TempDir dir;
   const std::string recording = dir.file("tunnel.mcap");
-  {
-    const Simulated sim = simulate_recording(dir, recording, "tunnel", 30, 4, {}, 300s);
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "tunnel", 30, 4, {}, 300s).ok);
   const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
   const Replay a = replay(dir, recording, "visible", "a");
   const Replay b = replay(dir, recording, "visible", "b", false);

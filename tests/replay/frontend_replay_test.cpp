@@ -25,10 +25,7 @@ TEST(FrontendReplay, ANightDriveRunsTheThreeModesOnTheSameFramesAndPosedReportsT
   TempDir dir;
   const std::string recording = dir.file("night.mcap");
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
-  {
-    const Simulated sim = simulate_recording(dir, recording, "street_night", 8, 4, {}, 180s);
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 8, 4, {}, 180s).ok);
   const std::string frames = dir.file("frames");
   PosedProcess inspect(
       {posectl, "inspect", "frontend", recording, "--config", source_dir() + "/config/posed.yaml",

@@ -36,11 +36,7 @@ Eigen::Vector3d position(const rec::ros2::StampedPose& p) {
 TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
-  {
-    const Simulated sim =
-        simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"});
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"}).ok);
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
                                   "\n  cyclonedds_config: " + source_dir() +
@@ -122,11 +118,7 @@ TEST(LioReplay, EveryLoopPassStartsAfreshAndRepeatsTheFirst) {
   // after the pass before it.
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
-  {
-    const Simulated sim =
-        simulate_recording(dir, recording, "street_night", 6, 8, {"--no-cameras"});
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 6, 8, {"--no-cameras"}).ok);
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
                                   "\n  cyclonedds_config: " + source_dir() +
@@ -216,11 +208,9 @@ TEST(LioReplay, ABurstOfCorruptLidarPacketsDoesNotStopTheLidar) {
   // gate while the stamp-ordered merge waited for the next scan: the lidar stopped for good.
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
-  {
-    const Simulated sim = simulate_recording(dir, recording, "street_night", 8, 8,
-                                             {"--no-cameras", "--fault", "corrupt_burst@4+1"});
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 8, 8,
+                                 {"--no-cameras", "--fault", "corrupt_burst@4+1"})
+                  .ok);
   const std::string config =
       dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
                                   "\n  cyclonedds_config: " + source_dir() +
@@ -268,11 +258,9 @@ TEST(LioReplay, PosectlExportPcdWritesTheMapAndItsKeyframesDeterministically) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   const std::string posectl = build_dir() + "/tools/posectl/posectl";
-  {
-    const Simulated sim = simulate_recording(dir, recording, "street_night", 12, 9,
-                                             {"--no-cameras", "--gt", dir.file("truth.txt")});
-    ASSERT_TRUE(sim.ok);
-  }
+  ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 12, 9,
+                                 {"--no-cameras", "--gt", dir.file("truth.txt")})
+                  .ok);
   for (const char* name : {"a.pcd", "b.pcd"}) {
     PosedProcess exporter({posectl, "export", recording, "--pcd", dir.file(name), "--config",
                            source_dir() + "/config/posed.yaml"},

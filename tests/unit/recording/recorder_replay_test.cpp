@@ -72,6 +72,14 @@ McapReplayConfig cfg(const std::string& path, const std::string& stream, double 
   return c;
 }
 
+/// The first half of the recording `name`, written to "cut.mcap" beside it: a recording whose
+/// writer died mid-chunk. Returns its path.
+std::string first_half(const test::TempDir& dir, const std::string& name) {
+  const auto full = test::slurp(dir.file(name));
+  test::spit(dir.file("cut.mcap"), std::span(full).subspan(0, full.size() / 2));
+  return dir.file("cut.mcap");
+}
+
 Captured replay_all(McapReplaySource& src) {
   Captured c;
   RawChunk chunk;
@@ -202,10 +210,7 @@ TEST(RecordReplay, ATruncatedRecordingReplaysUpToTheDamageAndSaysWhere) {
   RecorderOptions opt;
   opt.writer.chunk_size_bytes = 4096;
   const auto rec = record_synthetic(dir.file("c.mcap"), 2.0, opt);
-  const auto full = test::slurp(dir.file("c.mcap"));
-  const std::size_t cut = full.size() / 2;
-  test::spit(dir.file("cut.mcap"), std::span(full).subspan(0, cut));
-  McapReplaySource src(cfg(dir.file("cut.mcap"), "imu", 0));
+  McapReplaySource src(cfg(first_half(dir, "c.mcap"), "imu", 0));
   std::string error;
   ASSERT_TRUE(src.open(error)) << error;  // no summary: channels found while scanning
   const auto got = replay_all(src);
@@ -222,8 +227,7 @@ TEST(RecordReplay, ReadingAheadDeliversTheSameBytesStampsAndDamage) {
   RecorderOptions opt;
   opt.writer.chunk_size_bytes = 4096;
   const auto rec = record_synthetic(dir.file("a.mcap"), 0.6, opt);
-  const auto full = test::slurp(dir.file("a.mcap"));
-  test::spit(dir.file("cut.mcap"), std::span(full).subspan(0, full.size() / 2));
+  first_half(dir, "a.mcap");
   for (const char* file : {"a.mcap", "cut.mcap"}) {
     McapReplaySource itself(cfg(dir.file(file), "imu", 0));
     McapReplayConfig c = cfg(dir.file(file), "imu", 20.0);
