@@ -32,6 +32,12 @@ void run_as_background_thread(const std::string& name) {
   pthread_setname_np(pthread_self(), name.substr(0, 15).c_str());
 }
 
+/// A raw channel as the Source lists it, from its Channel record.
+ReplayChannel replay_channel(const McapChannelRecord& c) {
+  return {raw::parse_source_channel(raw::metadata_value(c.metadata, raw::kSourceChannelKey)),
+          c.topic, raw::metadata_value(c.metadata, raw::kWireFormatKey), c.metadata};
+}
+
 }  // namespace
 
 McapReplaySource::McapReplaySource(McapReplayConfig config)
@@ -64,9 +70,7 @@ bool McapReplaySource::open(std::string& error) {
       if (wanted(c)) {
         found = true;
         std::lock_guard lock(info_mutex_);
-        channels_[id] = {
-            raw::parse_source_channel(raw::metadata_value(c.metadata, raw::kSourceChannelKey)),
-            c.topic, raw::metadata_value(c.metadata, raw::kWireFormatKey), c.metadata};
+        channels_[id] = replay_channel(c);
       }
     }
     if (!found) {
@@ -203,20 +207,10 @@ bool McapReplaySource::fetch() {
     const auto id = m.channel->id;
     {
       // The channel's record, made the first time it is seen; its source channel goes with the
-      // message, so delivering it takes no second look (nor, with read-ahead, this lock).
+      // message, so delivering it needs no second look.
       std::lock_guard lock(info_mutex_);
       auto it = channels_.find(id);
-      if (it == channels_.end()) {
-        it =
-            channels_
-                .emplace(
-                    id, ReplayChannel{raw::parse_source_channel(raw::metadata_value(
-                                          m.channel->metadata, raw::kSourceChannelKey)),
-                                      m.channel->topic,
-                                      raw::metadata_value(m.channel->metadata, raw::kWireFormatKey),
-                                      m.channel->metadata})
-                .first;
-      }
+      if (it == channels_.end()) it = channels_.emplace(id, replay_channel(*m.channel)).first;
       pending_source_channel_ = it->second.source_channel;
     }
     const auto log = static_cast<std::int64_t>(m.log_time_ns);
