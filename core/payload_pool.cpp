@@ -1,8 +1,25 @@
 #include "core/payload_pool.hpp"
 
+#include <sys/mman.h>
+
+#include <new>
+
 namespace posed {
 
 namespace {
+// Pages straight from the kernel, not from malloc: none is resident until a buffer is first
+// written, so spare buffers (the lidar's cover the worst case, docs/faults.md) cost address
+// space, not memory; and all are unmapped when the pool goes, so they are the kernel's again.
+// malloc cannot promise either: once a freed block of this size has raised glibc's mmap threshold
+// (it follows the largest freed mapping up to 32 MB), the next pool of a --loop pass came from a
+// heap whose pages an earlier pass had made resident, and stayed there (docs/faults.md).
+std::byte* map_pages(std::size_t bytes) {
+  if (bytes == 0) return nullptr;
+  void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (p == MAP_FAILED) throw std::bad_alloc();
+  return static_cast<std::byte*>(p);
+}
+
 constexpr std::uint64_t pack(std::uint32_t index, std::uint32_t tag) {
   return (static_cast<std::uint64_t>(tag) << 32) | index;
 }
@@ -16,16 +33,18 @@ constexpr std::uint32_t tag_of(std::uint64_t head) {
 
 PayloadPool::PayloadPool(std::size_t buffer_count, std::size_t buffer_bytes)
     : buffer_bytes_(buffer_bytes),
-      // Not zeroed: a buffer's pages become resident when first written, so spare buffers (the
-      // lidar's cover the worst case, docs/faults.md) cost address space, not memory. A reused
-      // buffer holds its last payload anyway: nobody may read what it did not write.
-      storage_(std::make_unique_for_overwrite<std::byte[]>(buffer_count * buffer_bytes)),
+      // A reused buffer holds its last payload: nobody may read what it did not write.
+      storage_(map_pages(buffer_count * buffer_bytes), Unmap{buffer_count * buffer_bytes}),
       next_(buffer_count),
       head_(pack(buffer_count == 0 ? kNone : 0, 0)) {
   for (std::size_t i = 0; i < buffer_count; ++i) {
     next_[i].store(i + 1 < buffer_count ? static_cast<std::uint32_t>(i + 1) : kNone,
                    std::memory_order_relaxed);
   }
+}
+
+void PayloadPool::Unmap::operator()(std::byte* p) const {
+  if (p != nullptr) ::munmap(p, bytes);
 }
 
 PayloadPool::Lease PayloadPool::acquire() {

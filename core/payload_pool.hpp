@@ -70,8 +70,14 @@ class PayloadPool {
   void release(std::uint32_t index);
 
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+  /// Unmaps the storage (mapped by the constructor, see there).
+  struct Unmap {
+    std::size_t bytes = 0;
+    void operator()(std::byte* p) const;
+  };
+
   std::size_t buffer_bytes_;
-  std::unique_ptr<std::byte[]> storage_;
+  std::unique_ptr<std::byte[], Unmap> storage_;
   std::vector<std::atomic<std::uint32_t>> next_;
   /// low 32 bits: index of the top free buffer; high 32 bits: a tag against ABA
   std::atomic<std::uint64_t> head_;
