@@ -21,9 +21,13 @@ int main(int argc, char** argv) noexcept try {
   // glibc gives each thread that allocates an arena of its own and keeps what is freed there:
   // posed's stage threads (new ones each --loop pass) made resident memory creep up although the
   // heap in use did not (30 passes of a 10 s recording: heap and stacks +18.7 %; with two arenas
-  // +0.6 %, and 64 MB instead of 84-100 MB; docs/faults.md). Before any thread exists; an
+  // +0.6 %). With two, a pass whose big allocators drew the other arena than the pass before
+  // still held both arenas' worth (a 60 s recording looped at recorded timing for 10 minutes:
+  // +21 % over the first minute); with one and the payload pools mapped apart, +9 %
+  // (docs/faults.md, Endurance). The one lock every thread now allocates under cost the
+  // odometry nothing measurable (docs/realtime.md, stop 45). Before any thread exists; an
   // explicit MALLOC_ARENA_MAX in the environment wins.
-  if (std::getenv("MALLOC_ARENA_MAX") == nullptr) ::mallopt(M_ARENA_MAX, 2);
+  if (std::getenv("MALLOC_ARENA_MAX") == nullptr) ::mallopt(M_ARENA_MAX, 1);
   posed::log::set_program_name("posed");
   CLI::App app{
       "posed: real-time driver-to-pose daemon. Reads the VLP-32C, D435i, PLUG 617 and A9 (or the\n"
