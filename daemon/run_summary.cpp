@@ -177,6 +177,20 @@ bool print_run_summary(const RunSummary& r) {
                   span_s, processing_s);
     }
   }
+  {
+    // Most items ever waiting in each queue between the stages, against its capacity: a queue
+    // that filled is a stage that fell behind (at --max-speed the stages are the pace, and
+    // every queue fills by design).
+    std::string line;
+    std::uint64_t dropped = 0;
+    for (const pipeline::NamedQueueCounters& q : r.pipe.queue_counters()) {
+      line += (line.empty() ? "" : ", ") + q.name + " " + std::to_string(q.counters.high_water) +
+              "/" + std::to_string(q.counters.capacity);
+      dropped += q.counters.dropped();
+    }
+    std::printf("  queues              most waiting/capacity: %s; %llu dropped\n", line.c_str(),
+                static_cast<unsigned long long>(dropped));
+  }
   if (r.has_lidar) {
     std::printf(
         "  lidar scans         %llu assembled (%.0f points/scan mean), %llu reached the "

@@ -144,6 +144,21 @@ void Pipeline::add_stage(std::string name,
   stages_.push_back(std::move(stage));
 }
 
+std::vector<NamedQueueCounters> Pipeline::queue_counters() const {
+  std::vector<NamedQueueCounters> out;
+  out.push_back({"imu", imu_queue_.counters()});
+  if (backup_imu_queue_) out.push_back({"realsense_imu", backup_imu_queue_->counters()});
+  if (scan_queue_) out.push_back({"scans", scan_queue_->counters()});
+  for (const CameraStream s :
+       {CameraStream::kVisible, CameraStream::kThermal, CameraStream::kDepth}) {
+    if (const auto& q = image_queues_[index_of(s)])
+      out.push_back({std::string(to_string(s)), q->counters()});
+  }
+  out.push_back({"states", state_queue_.counters()});
+  if (anchor_queue_) out.push_back({"anchors", anchor_queue_->counters()});
+  return out;
+}
+
 std::vector<std::string> Pipeline::stage_names() const {
   std::vector<std::string> names;
   for (const StageBeat& beat : stage_heartbeats()) names.push_back(beat.name);

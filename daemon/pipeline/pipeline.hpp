@@ -128,6 +128,12 @@ struct PipelineOutputs {
   ScanObserver* scan_observer = nullptr;
 };
 
+/// One queue between the stages, for the summary: whether any grew towards its capacity.
+struct NamedQueueCounters {
+  std::string name;  ///< "imu", "scans", "visible", "states", ...
+  QueueCounters counters;
+};
+
 /// One stage's last sign of life, for the systemd watchdog.
 struct StageBeat {
   /// "imu_source", "lidar_source", "visible_source", "mapping", "fusion", "publisher",
@@ -183,6 +189,8 @@ class Pipeline {
   /// Localising: where base_link is in the map now (rt/initialpose); any thread. False without
   /// a prior map.
   bool set_initial_pose(const Eigen::Isometry3d& T_map_base);
+  /// Every queue between the stages this pipeline has, with its counters (any thread).
+  std::vector<NamedQueueCounters> queue_counters() const;
   /// The comparison front ends' figures (call after join(); empty without them).
   std::vector<CameraFigures> camera_compare_figures() const;
 

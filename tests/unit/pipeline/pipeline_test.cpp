@@ -66,6 +66,7 @@ struct RunResult {
   std::vector<NavState> states;
   PipelineStatus final_status;
   bool merged_in_stamp_order = false;
+  std::vector<NamedQueueCounters> queues;
 };
 
 RunResult run(std::unique_ptr<drivers::Source> source, const config::PosedConfig& c,
@@ -93,6 +94,7 @@ RunResult run(std::unique_ptr<drivers::Source> source, const config::PosedConfig
   }
   EXPECT_TRUE(pipe.finished()) << "pipeline did not drain within 20 s";
   pipe.join();
+  result.queues = pipe.queue_counters();
   return result;
 }
 
@@ -108,6 +110,17 @@ TEST(Pipeline, SyntheticRunIsLosslessAndFollowsTheMotion) {
   EXPECT_EQ(imu.dropped, 0u);
   EXPECT_EQ(imu.clock_state, "locked");
   EXPECT_EQ(r.final_status.mode, EstimatorMode::kStrapdown);
+  // The summary's queue line: the IMU's queue and the states', nothing for absent sensors.
+  std::vector<std::string> names;
+  for (const NamedQueueCounters& q : r.queues) names.push_back(q.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"imu", "states"}));
+  ASSERT_EQ(r.queues.size(), 2u);
+  const QueueCounters& imu_queue = r.queues[0].counters;
+  EXPECT_EQ(imu_queue.pushed, imu.decoded + 1);  // and the end of the stream
+  EXPECT_EQ(imu_queue.popped, imu_queue.pushed);
+  EXPECT_EQ(imu_queue.dropped(), 0u);
+  EXPECT_GE(imu_queue.high_water, 1u);
+  EXPECT_LE(imu_queue.high_water, imu_queue.capacity);
   // Alignment needs 1 s of the 2 s static start; every later sample gives a state.
   ASSERT_GT(r.states.size(), 2000u);
   EXPECT_EQ(r.final_status.states, r.states.size());
