@@ -28,8 +28,7 @@ constexpr double kRadius_m = 5.0;
 int test_domain() { return 1 + static_cast<int>(::getpid() % 99); }
 
 std::string demo_like_config(const std::string& extra = "") {
-  return "dds:\n  domain_id: " + std::to_string(test_domain()) +
-         "\n  cyclonedds_config: " + source_dir() + "/config/cyclonedds-loopback.xml\n" +
+  return loopback_dds_yaml(test_domain()) +
          "imu:\n  source: synthetic\n"
          "synthetic_imu:\n  radius_m: 5\n  speed_mps: 1\n  static_s: 1.5\n  ramp_s: 2\n" +
          extra + "estimator:\n  init_static_s: 0.5\n";
@@ -42,7 +41,7 @@ std::vector<std::string> posed_argv(const std::string& config_path) {
 dds::DdsConfig reader_config() {
   dds::DdsConfig c;
   c.domain_id = static_cast<std::uint32_t>(test_domain());
-  c.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  c.cyclonedds_xml_path = loopback_xml();
   return c;
 }
 

@@ -26,8 +26,7 @@ int test_domain() { return 1 + static_cast<int>((::getpid() + 12) % 99); }
 std::string posectl() { return build_dir() + "/tools/posectl/posectl"; }
 
 std::string dds_section(const std::string& security) {
-  return "dds:\n  domain_id: " + std::to_string(test_domain()) +
-         "\n  cyclonedds_config: " + source_dir() + "/config/cyclonedds-loopback.xml\n" + security;
+  return loopback_dds_yaml(test_domain()) + security;
 }
 
 void init_keystore(const TempDir& dir, const std::string& name) {
@@ -42,7 +41,7 @@ std::vector<std::string> echo_argv(const std::string& enclave) {
                                    "-d",
                                    std::to_string(test_domain()),
                                    "--cyclonedds-config",
-                                   source_dir() + "/config/cyclonedds-loopback.xml",
+                                   loopback_xml(),
                                    "-n",
                                    "20",
                                    "-t",
@@ -99,7 +98,7 @@ TEST(DdsSecurity, AReadersEnclaveCannotWritePosedsTopics) {
   init_keystore(dir, "keystore");
   dds::DdsConfig forger;
   forger.domain_id = static_cast<std::uint32_t>(test_domain());
-  forger.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  forger.cyclonedds_xml_path = loopback_xml();
   forger.security = dds::DdsSecurityFiles::from_enclave(dir.file("keystore") + "/enclaves/posectl");
   std::string error;
   EXPECT_EQ(dds::Publisher::create(forger, error), nullptr);

@@ -93,16 +93,15 @@ inline void run_hil_drive(const HilDrive& drive, HilDriveResult* result_out = nu
                                 "/sys\n  dev_dir: " + iio_dir + "/dev\n"
                           : std::string();
   const std::string config =
-      dir.write("posed.yaml",
-                dds_config(source_dir()) + "imu:\n  source: serial\n  serial_device: " + device +
-                    "\nlidar:\n  enabled: true\n  source: udp\n  address: 127.0.0.1\n"
-                    "  data_port: " +
-                    std::to_string(data_port) +
-                    "\n  position_port: " + std::to_string(position_port) + "\n" + realsense_imu);
+      dir.write("posed.yaml", dds_config() + "imu:\n  source: serial\n  serial_device: " + device +
+                                  "\nlidar:\n  enabled: true\n  source: udp\n  address: 127.0.0.1\n"
+                                  "  data_port: " +
+                                  std::to_string(data_port) + "\n  position_port: " +
+                                  std::to_string(position_port) + "\n" + realsense_imu);
 
   dds::DdsConfig reader_config;
   reader_config.domain_id = static_cast<std::uint32_t>(test_domain());
-  reader_config.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  reader_config.cyclonedds_xml_path = loopback_xml();
   std::string error;
   const std::array topics = {dds::Topic::kPose};
   auto reader = dds::Subscriber::create(reader_config, topics, error);

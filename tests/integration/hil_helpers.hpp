@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <string>
 
+#include "tests/integration/posed_process.hpp"
+
 namespace posed::testing::hil_helpers {
 
 // 1..99 like the other integration tests; +75 keeps these apart from the daemon (+0), lio (+25)
@@ -32,11 +34,8 @@ inline std::uint16_t free_port(int type) {
 inline std::uint16_t free_udp_port() { return free_port(SOCK_DGRAM); }
 inline std::uint16_t free_tcp_port() { return free_port(SOCK_STREAM); }
 
-/// The DDS and sensor part of a live posed's config: loopback DDS on the test's domain.
-inline std::string dds_config(const std::string& source_dir) {
-  return "dds:\n  domain_id: " + std::to_string(test_domain()) +
-         "\n  cyclonedds_config: " + source_dir + "/config/cyclonedds-loopback.xml\n";
-}
+/// The DDS part of a live posed's config: loopback DDS on the test's domain.
+inline std::string dds_config() { return loopback_dds_yaml(test_domain()); }
 
 /// The number after `label` in `text` (e.g. "udp data            22605 packets"), or -1.
 inline long long number_after(const std::string& text, const std::string& label) {

@@ -22,6 +22,13 @@ inline std::string source_dir() {
   const char* s = std::getenv("POSED_SOURCE_DIR");
   return s ? s : POSED_SOURCE_DIR_DEFAULT;
 }
+/// Cyclone DDS on loopback only, as every test runs it (no test talks to the network).
+inline std::string loopback_xml() { return source_dir() + "/config/cyclonedds-loopback.xml"; }
+/// posed.yaml's `dds:` section for a test: a domain of its own, Cyclone on loopback.
+inline std::string loopback_dds_yaml(int domain_id) {
+  return "dds:\n  domain_id: " + std::to_string(domain_id) +
+         "\n  cyclonedds_config: " + loopback_xml() + "\n";
+}
 inline std::string build_dir() {
   const char* s = std::getenv("POSED_BUILD_DIR");
   return s ? s : POSED_BUILD_DIR_DEFAULT;

@@ -84,7 +84,7 @@ TEST(PosectlRecord, RecordsTheSourcesUntilSigintAndPosedReplaysTheFile) {
   const std::uint16_t data_port = free_udp_port();
   const std::uint16_t position_port = free_udp_port();
   const std::string config =
-      dir.write("posed.yaml", dds_config(source_dir()) +
+      dir.write("posed.yaml", dds_config() +
                                   "imu:\n  source: synthetic\n"
                                   "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n"
                                   "lidar:\n  enabled: true\n  source: udp\n  address: 127.0.0.1\n"
@@ -182,7 +182,7 @@ TEST(PosedRecord, SigkillAtAnyMomentLeavesAFileThatReplaysToItsLastCompleteChunk
   for (int k = 0; k < kills; ++k) {
     TempDir dir;
     const std::string config =
-        dir.write("posed.yaml", dds_config(source_dir()) +
+        dir.write("posed.yaml", dds_config() +
                                     "imu:\n  source: synthetic\n"
                                     "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n"
                                     "estimator:\n  init_static_s: 0.5\n");
@@ -247,9 +247,8 @@ TEST(PosedRecord, SigkillAtAnyMomentLeavesAFileThatReplaysToItsLastCompleteChunk
 
 TEST(PosectlRecord, DurationAndSplitSizeMakeSeveralCompleteFiles) {
   TempDir dir;
-  const std::string config =
-      dir.write("posed.yaml", dds_config(source_dir()) + "imu:\n  source: synthetic\n" +
-                                  "synthetic_imu:\n  rate_hz: 1000\n");
+  const std::string config = dir.write("posed.yaml", dds_config() + "imu:\n  source: synthetic\n" +
+                                                         "synthetic_imu:\n  rate_hz: 1000\n");
   const std::string recording = dir.file("split.mcap");
   TempDir record_dir;
   // The synthetic A9 gives ~49 kB/s at 1000 Hz; 0.02 MB files rotate every ~0.4 s.
@@ -313,7 +312,7 @@ TEST(PosedReplay, RecordedConfigReplaysAsTheRobotRanWithTheRecordedCalibration) 
   const std::uint16_t position_port = free_udp_port();
   const std::string calibration = robot.write("vlp32c.yaml", vlp32c_calibration_yaml());
   const std::string robot_config =
-      robot.write("posed.yaml", dds_config(source_dir()) +
+      robot.write("posed.yaml", dds_config() +
                                     "imu:\n  source: synthetic\n"
                                     "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n  rate_hz: 250\n"
                                     "lidar:\n  enabled: true\n  source: udp\n  address: 127.0.0.1\n"
@@ -336,7 +335,7 @@ TEST(PosedReplay, RecordedConfigReplaysAsTheRobotRanWithTheRecordedCalibration) 
   std::filesystem::remove(calibration);
 
   TempDir laptop;
-  const std::string laptop_config = laptop.write("local.yaml", dds_config(source_dir()));
+  const std::string laptop_config = laptop.write("local.yaml", dds_config());
   const std::string posed = build_dir() + "/daemon/posed";
   // What it runs with: the robot's settings, the laptop's DDS.
   {

@@ -36,15 +36,12 @@ using namespace std::chrono_literals;
 // 1..99 like the other integration tests, +40 apart from theirs in a process with the same id.
 int test_domain() { return 1 + static_cast<int>((::getpid() + 40) % 99); }
 
-std::string dds_yaml() {
-  return "dds:\n  domain_id: " + std::to_string(test_domain()) +
-         "\n  cyclonedds_config: " + source_dir() + "/config/cyclonedds-loopback.xml\n";
-}
+std::string dds_yaml() { return loopback_dds_yaml(test_domain()); }
 
 dds::DdsConfig reader_config() {
   dds::DdsConfig c;
   c.domain_id = static_cast<std::uint32_t>(test_domain());
-  c.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  c.cyclonedds_xml_path = loopback_xml();
   return c;
 }
 

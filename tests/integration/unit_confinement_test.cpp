@@ -57,7 +57,7 @@ TEST(UnitConfinement, AReplayWithEverySensorRunsWithSchedFifoAndTheSamePoses) {
   // The recording's camera streams run through the camera front end (OpenCV's threads included).
   // Real-time priorities as config/posed.yaml asks for them (the schema's defaults are 0).
   const std::string config =
-      dir.write("posed.yaml", hil_helpers::dds_config(source_dir()) +
+      dir.write("posed.yaml", hil_helpers::dds_config() +
                                   "threads:\n  imu_source:\n    priority: 40\n  lidar_source:\n"
                                   "    priority: 35\n  fusion:\n    priority: 30\n  publisher:\n"
                                   "    priority: 20\n");

@@ -270,10 +270,7 @@ TEST(BagReplay, ASimulatedDriveImportedFromARos1BagIsTrackedInTheBagsTimeBase) {
     EXPECT_GE(whole_rotation_late + 1, clouds);
   }
 
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+  const std::string config = dir.write("posed.yaml", loopback_dds_yaml(test_domain()));
   const std::string poses = dir.file("poses.mcap");
   {
     PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", imported,

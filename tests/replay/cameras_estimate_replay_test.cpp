@@ -58,9 +58,7 @@ struct Replay {
 Replay replay(TempDir& dir, const std::string& recording, const std::string& mode,
               const std::string& name, bool own_thread = true) {
   const std::string config =
-      dir.write(name + ".yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                    "\n  cyclonedds_config: " + source_dir() +
-                                    "/config/cyclonedds-loopback.xml\nfrontend:\n  mode: " + mode +
+      dir.write(name + ".yaml", loopback_dds_yaml(test_domain()) + "frontend:\n  mode: " + mode +
                                     "\n  own_thread: " + (own_thread ? "true" : "false") + "\n");
   PosedProcess posed(
       {build_dir() + "/daemon/posed", "--config", config, "--replay", recording, "--max-speed",

@@ -87,11 +87,10 @@ TEST(CanReplay, ACandumpImportReplaysIntoTheFusionCore) {
   }
 
   // posed as a user runs it: the example's imu section, DDS on loopback in a domain of its own.
-  const std::string config = dir.write(
-      "posed.yaml",
-      "dds:\n  domain_id: " + std::to_string(test_domain()) + "\n  cyclonedds_config: " +
-          source_dir() + "/config/cyclonedds-loopback.xml\nimu:\n  source: can\n  rate_hz: " +
-          std::to_string(kRateHz) + "\n  can_mapping: " + config::can_mapping_yaml(mapping) + "\n");
+  const std::string config =
+      dir.write("posed.yaml", loopback_dds_yaml(test_domain()) +
+                                  "imu:\n  source: can\n  rate_hz: " + std::to_string(kRateHz) +
+                                  "\n  can_mapping: " + config::can_mapping_yaml(mapping) + "\n");
   {
     PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", imported,
                         "--max-speed", "--wait-subscribers", "0"},
@@ -110,10 +109,7 @@ TEST(CanReplay, ACandumpImportReplaysIntoTheFusionCore) {
   // Without imu.can_mapping nothing says which frames are the IMU's: every frame is counted as
   // malformed, said apart as a configuration problem, and the log says where a mapping comes from.
   {
-    const std::string unmapped =
-        dir.write("unmapped.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                       "\n  cyclonedds_config: " + source_dir() +
-                                       "/config/cyclonedds-loopback.xml\n");
+    const std::string unmapped = dir.write("unmapped.yaml", loopback_dds_yaml(test_domain()));
     PosedProcess posed({build_dir() + "/daemon/posed", "--config", unmapped, "--replay", imported,
                         "--max-speed", "--wait-subscribers", "0"},
                        {}, dir);

@@ -75,9 +75,7 @@ TEST(FrontendReplay, ANightDriveRunsTheThreeModesOnTheSameFramesAndPosedReportsT
   // posed itself, in seed 000's fused mode: the front end's summary line, and two replays agree
   // to the byte.
   const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\nfrontend:\n  mode: fused\n");
+      dir.write("posed.yaml", loopback_dds_yaml(test_domain()) + "frontend:\n  mode: fused\n");
   std::string lines[2];
   for (std::string& line : lines) {
     PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,

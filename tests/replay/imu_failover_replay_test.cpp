@@ -34,11 +34,9 @@ struct Replay {
 /// `realsense_imu` holds more of that section's keys, each line indented by two spaces.
 Replay replay(TempDir& dir, const std::string& recording, const std::string& name, bool failover,
               const std::string& realsense_imu = "") {
-  const std::string config = dir.write(
-      name + ".yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                          "\n  cyclonedds_config: " + source_dir() +
-                          "/config/cyclonedds-loopback.xml\nrealsense_imu:\n  failover: " +
-                          (failover ? "true" : "false") + "\n" + realsense_imu);
+  const std::string config =
+      dir.write(name + ".yaml", loopback_dds_yaml(test_domain()) + "realsense_imu:\n  failover: " +
+                                    (failover ? "true" : "false") + "\n" + realsense_imu);
   const std::string out = dir.file(name + ".mcap");
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--wait-subscribers", "0", "--record", out},

@@ -37,10 +37,7 @@ TEST(LioReplay, ASimulatedStreetDriveIsTrackedAndReplaysAreIdentical) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 15, 8, {"--no-cameras"}).ok);
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+  const std::string config = dir.write("posed.yaml", loopback_dds_yaml(test_domain()));
   std::vector<std::string> outputs;
   for (const char* name : {"a.mcap", "b.mcap"}) {
     PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
@@ -119,10 +116,7 @@ TEST(LioReplay, EveryLoopPassStartsAfreshAndRepeatsTheFirst) {
   TempDir dir;
   const std::string recording = dir.file("street.mcap");
   ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 6, 8, {"--no-cameras"}).ok);
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+  const std::string config = dir.write("posed.yaml", loopback_dds_yaml(test_domain()));
   PosedProcess posed(
       {build_dir() + "/daemon/posed", "--config", config, "--replay", recording, "--max-speed",
        "--loop", "--passes", "3", "--wait-subscribers", "0", "--record", dir.file("loop.mcap")},
@@ -167,10 +161,7 @@ TEST(LioReplay, ALidarOutageIsReportedInTheDataTimeAndTheOdometryCarriesOnThroug
     ASSERT_TRUE(sim.ok);
     EXPECT_NE(sim.out.find("fault lidar_outage@4+2"), std::string::npos) << sim.out;
   }
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+  const std::string config = dir.write("posed.yaml", loopback_dds_yaml(test_domain()));
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--wait-subscribers", "0", "--record", dir.file("out.mcap")},
                      {}, dir);
@@ -211,10 +202,7 @@ TEST(LioReplay, ABurstOfCorruptLidarPacketsDoesNotStopTheLidar) {
   ASSERT_TRUE(simulate_recording(dir, recording, "street_night", 8, 8,
                                  {"--no-cameras", "--fault", "corrupt_burst@4+1"})
                   .ok);
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+  const std::string config = dir.write("posed.yaml", loopback_dds_yaml(test_domain()));
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--wait-subscribers", "0", "--record", dir.file("out.mcap")},
                      {}, dir);

@@ -76,10 +76,7 @@ TEST(LocalisationReplay, ASecondDriveLocalisesOnTheSavedMapWithinTwoSecondsAndSt
   // Drive seed 12 of this world starts 33 s into the default drive's path (within 0.5 m).
   simulate("second_drive", "12", {"--drive-seed", "12"});
 
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n");
+  const std::string config = dir.write("posed.yaml", loopback_dds_yaml(test_domain()));
   const std::string map_dir = dir.file("map");
   {
     PosedProcess posed(

@@ -31,9 +31,7 @@ TEST(LoopClosureReplay, ARoomsLapsCloseLoopsIdenticallyOnEveryReplayAndLeaveOdom
   TempDir dir;
   const std::string recording = dir.file("room.mcap");
   ASSERT_TRUE(simulate_recording(dir, recording, "room", 50, 3, {"--no-cameras"}, 180s).ok);
-  const std::string dds = "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                          "\n  cyclonedds_config: " + source_dir() +
-                          "/config/cyclonedds-loopback.xml\n";
+  const std::string dds = loopback_dds_yaml(test_domain());
   // The room's lap is shorter than the shipped 30 s separation.
   const std::string with_loops =
       dir.write("loops.yaml", dds + "mapping:\n  loop_closure: true\n  min_separation_s: 12\n");

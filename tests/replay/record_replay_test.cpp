@@ -24,8 +24,7 @@ using namespace std::chrono_literals;
 int test_domain() { return 1 + static_cast<int>((::getpid() + 50) % 99); }
 
 std::string config_text() {
-  return "dds:\n  domain_id: " + std::to_string(test_domain()) +
-         "\n  cyclonedds_config: " + source_dir() + "/config/cyclonedds-loopback.xml\n" +
+  return loopback_dds_yaml(test_domain()) +
          "imu:\n  source: synthetic\n"
          "synthetic_imu:\n  static_s: 1.5\n  ramp_s: 2\n"
          "estimator:\n  init_static_s: 0.5\n";
@@ -58,7 +57,7 @@ ReplayRun replay(const TempDir& dir, const std::string& config, const std::strin
   const std::array topics = {dds::Topic::kPose};
   dds::DdsConfig c;
   c.domain_id = static_cast<std::uint32_t>(test_domain());
-  c.cyclonedds_xml_path = source_dir() + "/config/cyclonedds-loopback.xml";
+  c.cyclonedds_xml_path = loopback_xml();
   auto reader = dds::Subscriber::create(c, topics, error);
   EXPECT_TRUE(reader) << error;
   PosedProcess p(

@@ -52,11 +52,8 @@ TEST(SimCamerasReplay, DepthAndRawThermalDecodeAndTheDepthImageGivesFeaturesDept
     depth_frames = std::stoi(m[3]);
     EXPECT_NEAR(depth_frames, 45, 2);
   }
-  const std::string config =
-      dir.write("posed.yaml", "dds:\n  domain_id: " + std::to_string(test_domain()) +
-                                  "\n  cyclonedds_config: " + source_dir() +
-                                  "/config/cyclonedds-loopback.xml\n"
-                                  "depth_camera:\n  feature_depth: true\n");
+  const std::string config = dir.write(
+      "posed.yaml", loopback_dds_yaml(test_domain()) + "depth_camera:\n  feature_depth: true\n");
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--wait-subscribers", "0"},
                      {}, dir);

@@ -50,7 +50,7 @@ TEST(StreamsReplay, OnlyTheNamedStreamsAreReplayedAndAMissingOneIsRefused) {
   EXPECT_NE(error.find("must include imu"), std::string::npos) << error;
 
   // As a user runs it: the IMU alone, the lidar listed as left out.
-  const std::string config = dir.write("posed.yaml", hil_helpers::dds_config(source_dir()));
+  const std::string config = dir.write("posed.yaml", hil_helpers::dds_config());
   PosedProcess posed({build_dir() + "/daemon/posed", "--config", config, "--replay", recording,
                       "--max-speed", "--streams", "imu", "--wait-subscribers", "0"},
                      {}, dir);
