@@ -149,8 +149,7 @@ std::vector<NamedQueueCounters> Pipeline::queue_counters() const {
   out.push_back({"imu", imu_queue_.counters()});
   if (backup_imu_queue_) out.push_back({"realsense_imu", backup_imu_queue_->counters()});
   if (scan_queue_) out.push_back({"scans", scan_queue_->counters()});
-  for (const CameraStream s :
-       {CameraStream::kVisible, CameraStream::kThermal, CameraStream::kDepth}) {
+  for (const CameraStream s : kCameraStreams) {
     if (const auto& q = image_queues_[index_of(s)])
       out.push_back({std::string(to_string(s)), q->counters()});
   }

@@ -1,7 +1,6 @@
 #include "core/payload_pool.hpp"
 
 #include <gtest/gtest.h>
-#include <malloc.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
