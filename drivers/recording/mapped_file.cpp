@@ -65,17 +65,22 @@ bool MappedFile::open(const std::string& path, std::string& error, std::string_v
     return false;
   }
   ::madvise(p, size_, MADV_SEQUENTIAL);
+  // No 2 MB page-table mappings of the page cache's large folios: releasing part of one unmaps
+  // all of it, and the reader maps it whole again with its next record (a replay's readers held
+  // 8 MB of a file between two of them, 4.6 MB without).
+  ::madvise(p, size_, MADV_NOHUGEPAGE);
   data_ = static_cast<const std::byte*>(p);
   return true;
 }
 
-void MappedFile::release(std::size_t begin, std::size_t end) {
+std::size_t MappedFile::release(std::size_t begin, std::size_t end) {
   static const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
-  begin = (begin + page - 1) / page * page;
+  const std::size_t first = (begin + page - 1) / page * page;
   end = std::min(end, size_) / page * page;
-  if (data_ == nullptr || end <= begin) return;
+  if (data_ == nullptr || end <= first) return begin;
   // MAP_PRIVATE and never written: dropped pages read back from the file unchanged.
-  ::madvise(const_cast<std::byte*>(data_) + begin, end - begin, MADV_DONTNEED);
+  ::madvise(const_cast<std::byte*>(data_) + first, end - first, MADV_DONTNEED);
+  return end;
 }
 
 }  // namespace posed::drivers::recording

@@ -27,7 +27,10 @@ class MappedFile {
   /// Drops the pages wholly inside bytes [begin, end) from this process's resident memory (a
   /// reader walking front to back is done with them): without it a long replay's RSS grows by
   /// the recording's size. Their bytes stay readable: the kernel pages them in again if touched.
-  void release(std::size_t begin, std::size_t end);
+  /// Returns where the released pages end (`end` down to a page, at least `begin`): the next
+  /// release starts there, so no page is left between two (a reader releasing after every
+  /// image-sized record kept one page in 16 of the file, 65 MB over a minute of replay).
+  std::size_t release(std::size_t begin, std::size_t end);
   std::span<const std::byte> bytes() const { return {data_, size_}; }
   const std::string& path() const { return path_; }
 

@@ -7,6 +7,9 @@
 // chunks that decompressed to their size and passed their CRC are shared; a reader that misses
 // (evicted, or far ahead) decompresses on its own, so nothing depends on the cache but speed.
 // Thread-safe; a chunk handed out stays alive while a reader walks it, whatever is evicted.
+// Chunk buffers are reused: a replay decompresses megabytes a second, and fresh 1 MB blocks
+// interleaved with the estimator's long-lived allocations left the heap holding 10-15 MB more at
+// the end of one pass of a looped replay than another (docs/faults.md, stop 46).
 
 #include <cstddef>
 #include <cstdint>
@@ -29,6 +32,35 @@ class McapChunkCache {
 
   /// Keeps the `capacity` chunks most recently added.
   explicit McapChunkCache(std::size_t capacity = 32) : capacity_(capacity) {}
+
+  /// A buffer to decompress a chunk into (resize it; what it holds is a stale chunk's bytes) and
+  /// then add(): the storage of a chunk that was evicted and that no reader walks any more when
+  /// there is one, else new.
+  std::shared_ptr<std::vector<std::byte>> buffer() {
+    std::unique_ptr<std::vector<std::byte>> storage;
+    {
+      std::lock_guard lock(spare_->mutex);
+      if (!spare_->buffers.empty()) {
+        storage = std::move(spare_->buffers.back());
+        spare_->buffers.pop_back();
+        ++spare_->reused;
+      }
+    }
+    if (!storage) storage = std::make_unique<std::vector<std::byte>>();
+    // The deleter holds the spare list, not the cache: a reader may outlive the cache.
+    return {storage.release(), [spare = spare_](std::vector<std::byte>* b) {
+              std::unique_ptr<std::vector<std::byte>> owned(b);
+              std::lock_guard lock(spare->mutex);
+              if (spare->buffers.size() < kMaxSpareBuffers)
+                spare->buffers.push_back(std::move(owned));
+            }};
+  }
+
+  /// buffer() calls served by a buffer a chunk had before [1]
+  std::uint64_t buffers_reused() const {
+    std::lock_guard lock(spare_->mutex);
+    return spare_->reused;
+  }
 
   /// The chunk at file offset `offset`, decompressed and checked, or null.
   Chunk find(std::uint64_t offset) {
@@ -68,7 +100,17 @@ class McapChunkCache {
   }
 
  private:
+  /// Evicted chunks free their buffers one at a time, and each is taken again by the next
+  /// decompression; a few spare cover readers that drop several at once.
+  static constexpr std::size_t kMaxSpareBuffers = 4;
+  struct Spare {
+    std::mutex mutex;
+    std::vector<std::unique_ptr<std::vector<std::byte>>> buffers;
+    std::uint64_t reused = 0;
+  };
+
   const std::size_t capacity_;
+  std::shared_ptr<Spare> spare_ = std::make_shared<Spare>();
   mutable std::mutex mutex_;
   std::deque<std::pair<std::uint64_t, Chunk>> chunks_;  // oldest first
   McapChunkCacheCounters counters_;

@@ -52,11 +52,18 @@ const char* mcap::op_name(std::uint8_t opcode) {
 
 namespace {
 
-/// How much read file next() lets accumulate before it releases it from memory (one madvise,
-/// microseconds). A replay runs a reader per stream over the same file: at 32 MB the mapped pages
-/// alone swung posed's resident memory by 60 MB (75-136 MB over a 10-minute replay at recorded
-/// timing), at 4 MB 40-71 MB (the data CRC's 8 MB steps hold the rest back).
-constexpr std::uint64_t kReleaseStepBytes = 4u << 20;
+/// How much read file next() lets accumulate before it releases it from memory (one madvise, a
+/// few microseconds), and the step in which the data CRC is folded. A replay runs a reader per
+/// stream over the same mapping, so what each holds adds up: at 32 MB the mapped pages swung
+/// posed's resident memory by 60 MB over a 10-minute replay at recorded timing, at 4 MB (and the
+/// CRC in 8 MB steps) still by 20 MB from one sample to the next (docs/faults.md, stop 46). A
+/// reader now holds its current record and at most this much behind it.
+constexpr std::uint64_t kReleaseStepBytes = 256u << 10;
+/// How far behind what it released last a release starts again. A page fault maps the pages around
+/// the faulting one that the page cache holds (fault-around: 64 kB by default, a whole large folio
+/// on newer kernels), some of them behind what was released: a reader that skips the chunks
+/// another decompressed touches little more than record headers, and so kept 3.4 % of the file.
+constexpr std::uint64_t kFaultAroundSlackBytes = 2u << 20;
 
 std::string fmt(const char* f, auto... args) {
   char buf[256];
@@ -431,9 +438,7 @@ bool McapReader::enter_chunk(std::span<const std::byte> body, std::uint64_t offs
   // this reader has moved on.
   // Only what this reader checked is shared.
   std::shared_ptr<std::vector<std::byte>> own =
-      cache != nullptr && (options_.verify_crcs || crc == 0)
-          ? std::make_shared<std::vector<std::byte>>()
-          : nullptr;
+      cache != nullptr && (options_.verify_crcs || crc == 0) ? cache->buffer() : nullptr;
   std::vector<std::byte>& buf = own ? *own : chunk_buf_;
   if (compression.empty()) {
     if (records.size() != uncompressed_size) {
@@ -516,8 +521,10 @@ bool McapReader::next(McapMessage& out) {
     // resident memory with it, in steps large enough to cost nothing.
     const std::uint64_t done_with = verify_data_crc_ ? std::min(at, crc_pos_) : at;
     if (done_with >= released_ + kReleaseStepBytes) {
-      mapped_.release(static_cast<std::size_t>(released_), static_cast<std::size_t>(done_with));
-      released_ = done_with;
+      const std::uint64_t again_from =
+          released_ > kFaultAroundSlackBytes ? released_ - kFaultAroundSlackBytes : 0;
+      released_ = mapped_.release(static_cast<std::size_t>(again_from),
+                                  static_cast<std::size_t>(done_with));
     }
     if (at >= file_.size()) {
       stop(at, "the file ends without a DataEnd record (cut short?)");
@@ -556,8 +563,8 @@ bool McapReader::next(McapMessage& out) {
       counters_.bytes_scanned = record_end;
       return false;
     }
-    if (verify_data_crc_ && record_end - crc_pos_ > (8u << 20)) {
-      // fold the data CRC forward in large steps, so it costs one pass over the file
+    if (verify_data_crc_ && record_end - crc_pos_ > kReleaseStepBytes) {
+      // fold the data CRC forward in steps, one pass over the file, and let the pages go
       data_crc_.update(file_.subspan(static_cast<std::size_t>(crc_pos_),
                                      static_cast<std::size_t>(record_end - crc_pos_)));
       crc_pos_ = record_end;

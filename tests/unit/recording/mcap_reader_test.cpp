@@ -4,9 +4,15 @@
 
 #include "drivers/recording/mcap_reader.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -67,6 +73,134 @@ std::vector<std::uint32_t> read_sequences(McapReader& r) {
   }
   return seq;
 }
+
+/// Resident memory of this process's mapping of `path` [kB] (from /proc/self/smaps), 0 if none.
+std::size_t mapped_resident_kb(const std::string& path) {
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool in_file = false;
+  std::size_t kb = 0;
+  while (std::getline(smaps, line)) {
+    if (line.empty()) continue;
+    if (std::isxdigit(static_cast<unsigned char>(line[0])) != 0 && line.find('-') < 17) {
+      in_file = line.size() >= path.size() &&
+                line.compare(line.size() - path.size(), path.size(), path) == 0;
+    } else if (in_file && line.rfind("Rss:", 0) == 0) {
+      std::istringstream in(line.substr(4));
+      std::size_t v = 0;
+      in >> v;
+      kb += v;
+    }
+  }
+  return kb;
+}
+
+class Residency : public ::testing::TestWithParam<bool> {};
+
+TEST_P(Residency, AReaderHoldsLittleMoreOfTheFileThanTheChunkItWalks) {
+  // A replay runs a reader per stream over one mapping of the file: what each keeps resident
+  // behind it adds up in posed's memory, and the data CRC reads every byte.
+  test::TempDir dir("mcap_resident");
+  const std::string path = dir.file("big.mcap");
+  {
+    McapWriterOptions opt;
+    opt.compression = McapCompression::kNone;
+    opt.chunk_size_bytes = 64u << 10;
+    opt.fsync_on_close = false;
+    McapWriter w;
+    std::string error;
+    ASSERT_TRUE(w.open(path, opt, error)) << error;
+    const auto ch = w.add_channel("/image", "posed-raw", 0, {});
+    std::vector<std::byte> image(16u << 10);
+    for (std::uint32_t i = 0; i < 1024; ++i) {  // 16 MB in 256 chunks
+      std::memset(image.data(), static_cast<int>(i), image.size());
+      ASSERT_TRUE(w.write_message(ch, i, 1'000'000 + i * 1000ull, i, image));
+    }
+    ASSERT_TRUE(w.close()) << w.error();
+  }
+  // With the CRCs checked the reader touches every byte; without, as a replay's reader that finds
+  // its chunks decompressed by another, little more than the record headers, and each page
+  // fault maps pages around the one touched, some behind what the reader released.
+  McapReaderOptions options;
+  options.verify_crcs = GetParam();
+  McapReader r;
+  std::string error;
+  ASSERT_TRUE(r.open(path, error, options)) << error;
+  McapMessage m;
+  std::size_t most_kb = 0, messages = 0;
+  while (r.next(m)) {
+    ASSERT_EQ(m.data.size(), 16u << 10);
+    EXPECT_EQ(m.data[100], static_cast<std::byte>(m.sequence & 0xFF));
+    if (++messages % 16 == 0) most_kb = std::max(most_kb, mapped_resident_kb(path));
+  }
+  EXPECT_EQ(messages, 1024u);
+  EXPECT_TRUE(r.complete());
+  EXPECT_GT(most_kb, 0u) << "the mapping was found in /proc/self/smaps";
+  // The chunk being walked and the step behind it. At 4 MB release steps and the CRC in 8 MB
+  // ones a reader held up to 12 MB of this file; releasing from where the last release began
+  // its page rather than where it ended kept a page per chunk; not releasing again behind it
+  // kept the pages a fault mapped around the next record's header.
+  EXPECT_LE(most_kb, 512u) << "largest resident part of the 16 MB file's mapping";
+  EXPECT_LE(mapped_resident_kb(path), 512u) << "at the end";
+}
+
+/// Writes `path` out and drops it from the page cache, so that reading it fills the cache as a
+/// recording made earlier does (read-ahead's large folios, not the writes').
+void drop_from_page_cache(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(fd, 0) << path;
+  EXPECT_EQ(::fdatasync(fd), 0);
+  EXPECT_EQ(::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED), 0);
+  ::close(fd);
+}
+
+TEST(Residency, ReadersSharingChunksHoldLittleOfTheFileBetweenThem) {
+  // A replay's readers side by side: the first decompresses each chunk and checks the CRCs, the
+  // other finds the chunks decompressed and touches little more than their headers, and a page
+  // fault maps the pages around the one touched, some of them behind what it had released.
+  test::TempDir dir("mcap_resident_shared");
+  const std::string path = dir.file("big.mcap");
+  {
+    McapWriterOptions opt;
+    opt.compression = McapCompression::kLz4;
+    opt.chunk_size_bytes = 256u << 10;
+    opt.fsync_on_close = false;
+    McapWriter w;
+    std::string error;
+    ASSERT_TRUE(w.open(path, opt, error)) << error;
+    const auto ch = w.add_channel("/scan", "posed-raw", 0, {});
+    std::vector<std::byte> noise(64u << 10);
+    std::uint32_t x = 12345;
+    for (std::uint32_t i = 0; i < 1024; ++i) {  // 64 MB that lz4 cannot shrink
+      for (auto& b : noise) b = static_cast<std::byte>((x = x * 1664525u + 1013904223u) >> 24);
+      ASSERT_TRUE(w.write_message(ch, i, 1'000'000 + i * 1000ull, i, noise));
+    }
+    ASSERT_TRUE(w.close()) << w.error();
+  }
+  drop_from_page_cache(path);
+  McapReaderOptions options;
+  options.chunk_cache = std::make_shared<McapChunkCache>();
+  McapReader first, second;
+  std::string error;
+  ASSERT_TRUE(first.open(path, error, options)) << error;
+  ASSERT_TRUE(second.open(path, error, options)) << error;
+  McapMessage m;
+  std::size_t most_kb = 0, messages = 0;
+  for (bool more = true; more;) {
+    more = first.next(m);
+    if (second.next(m)) ++messages;
+    if (messages % 16 == 0) most_kb = std::max(most_kb, mapped_resident_kb(path));
+  }
+  EXPECT_EQ(messages, 1024u);
+  EXPECT_EQ(options.chunk_cache->counters().hits, options.chunk_cache->counters().misses);
+  // The kernel maps a whole large folio of the page cache on a fault (up to 2 MB ahead of the
+  // record touched), so each reader may hold a few MB however large the file. Without releasing
+  // again behind what was released, the second reader kept 3.4 % of the file it had passed.
+  EXPECT_LE(most_kb, 8192u) << "largest resident part of the two mappings of the 64 MB file";
+  EXPECT_LE(mapped_resident_kb(path), 1024u) << "once both have read to the end";
+}
+
+INSTANTIATE_TEST_SUITE_P(CrcChecked, Residency, ::testing::Bool());
 
 class RoundTrip : public ::testing::TestWithParam<McapCompression> {};
 
@@ -249,6 +383,26 @@ TEST(ChunkCache, ReadersOfOneFileShareDecompressedChunksAndNeverADamagedOne) {
   };
   EXPECT_EQ(data_crc_issues(first), 1);
   EXPECT_EQ(data_crc_issues(second), 0);
+}
+
+TEST(ChunkCache, AnEvictedChunksBufferIsReusedOnlyOnceNoReaderWalksIt) {
+  McapChunkCache cache(1);
+  auto first = cache.buffer();
+  first->resize(1000);
+  const std::vector<std::byte>* const first_storage = first.get();
+  cache.add(0, std::move(first));
+  McapChunkCache::Chunk walked = cache.find(0);  // a reader walks the chunk at offset 0
+  auto second = cache.buffer();
+  EXPECT_NE(second.get(), first_storage);
+  cache.add(100, std::move(second));  // evicts offset 0, which the reader still walks
+  auto third = cache.buffer();
+  EXPECT_NE(third.get(), first_storage) << "handed out while a reader walks it";
+  EXPECT_EQ(cache.buffers_reused(), 0u);
+  walked.reset();  // the reader moves on: the storage is free for the next chunk
+  auto fourth = cache.buffer();
+  EXPECT_EQ(fourth.get(), first_storage);
+  EXPECT_GE(fourth->capacity(), 1000u) << "its allocation kept";
+  EXPECT_EQ(cache.buffers_reused(), 1u);
 }
 
 TEST(BadInput, ASummaryWithABadCrcFallsBackToTheScan) {
