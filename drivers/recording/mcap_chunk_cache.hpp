@@ -30,8 +30,12 @@ class McapChunkCache {
  public:
   using Chunk = std::shared_ptr<const std::vector<std::byte>>;
 
-  /// Keeps the `capacity` chunks most recently added.
-  explicit McapChunkCache(std::size_t capacity = 32) : capacity_(capacity) {}
+  /// Keeps the chunks most recently added, up to `capacity_bytes` decompressed (the newest
+  /// always). The streams read within a read-ahead window (150 ms) of each other at recorded
+  /// timing and within their queues' depth at full speed: 16 MB is a few seconds of a four-sensor
+  /// recording. (32 chunks, as it was, held 85 MB of a replay's 155 MB heap.)
+  explicit McapChunkCache(std::size_t capacity_bytes = 16u << 20)
+      : capacity_bytes_(capacity_bytes) {}
 
   /// A buffer to decompress a chunk into (resize it; what it holds is a stale chunk's bytes) and
   /// then add(): the storage of a chunk that was evicted and that no reader walks any more when
@@ -80,8 +84,12 @@ class McapChunkCache {
     for (const auto& entry : chunks_) {
       if (entry.first == offset) return;  // another reader was quicker
     }
+    bytes_ += chunk->size();
     chunks_.emplace_back(offset, std::move(chunk));
-    if (chunks_.size() > capacity_) chunks_.pop_front();
+    while (chunks_.size() > 1 && bytes_ > capacity_bytes_) {
+      bytes_ -= chunks_.front().second->size();
+      chunks_.pop_front();
+    }
   }
 
   /// True for the first reader that asks (on its first read): that one folds the data section's
@@ -109,7 +117,8 @@ class McapChunkCache {
     std::uint64_t reused = 0;
   };
 
-  const std::size_t capacity_;
+  const std::size_t capacity_bytes_;
+  std::size_t bytes_ = 0;  // decompressed bytes of the chunks held
   std::shared_ptr<Spare> spare_ = std::make_shared<Spare>();
   mutable std::mutex mutex_;
   std::deque<std::pair<std::uint64_t, Chunk>> chunks_;  // oldest first

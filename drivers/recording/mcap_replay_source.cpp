@@ -84,6 +84,8 @@ bool McapReplaySource::open(std::string& error) {
   opened_ = true;
   if (config_.read_ahead.ns > 0) {
     ahead_ = std::make_unique<SpscQueue<AheadMessage>>(kReadAheadMessages, DropPolicy::kDropNewest);
+    spare_bytes_ =
+        std::make_unique<SpscQueue<std::vector<std::byte>>>(kSpareBuffers, DropPolicy::kDropNewest);
     reader_thread_ = std::thread([this] { read_ahead_loop(); });
   }
   return true;
@@ -103,6 +105,9 @@ void McapReplaySource::read_ahead_loop() {
   bool first = true;
   while (!stop_.load(std::memory_order_relaxed) && fetch()) {
     AheadMessage m;
+    if (pending_.data.size() >= kRecycledBytes && spare_bytes_->try_pop(m.bytes)) {
+      ahead_reused_.fetch_add(1, std::memory_order_relaxed);
+    }
     m.bytes.assign(pending_.data.begin(), pending_.data.end());
     m.source_channel = pending_source_channel_;
     m.log_ns = pending_log_ns_;
@@ -140,6 +145,8 @@ bool McapReplaySource::take_ahead(Duration timeout) {
   for (;;) {
     // Read before the pop: ended and then empty means nothing more will come.
     const bool ended = ahead_ended_.load();
+    // The last message's bytes are done with (read() handed them out until this call).
+    if (current_.bytes.capacity() >= kRecycledBytes) spare_bytes_->push(std::move(current_.bytes));
     if (ahead_->try_pop(current_)) {
       ++ahead_taken_;
       ahead_base_log_ns_.store(current_.log_ns);

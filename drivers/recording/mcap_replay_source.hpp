@@ -101,6 +101,11 @@ class McapReplaySource final : public Source {
  public:
   /// The most messages read ahead at once (McapReplayConfig::read_ahead), whatever their span.
   static constexpr std::size_t kReadAheadMessages = 1024;
+  /// The most buffers read() hands back to the read-ahead thread at once; more are freed.
+  static constexpr std::size_t kSpareBuffers = 4;
+  /// Messages from this size on (images) are copied into a buffer handed back; smaller ones
+  /// (packets, metadata) into their own, so a packet never holds an image's buffer.
+  static constexpr std::size_t kRecycledBytes = 64u << 10;
 
   explicit McapReplaySource(McapReplayConfig config);
   ~McapReplaySource() override;
@@ -136,6 +141,8 @@ class McapReplaySource final : public Source {
   /// Call when the Source is not being read (after the pipeline joined). With read-ahead, what
   /// was read from the file: the same once the stream has ended.
   DeliveredSpan delivered_span() const;
+  /// With read-ahead: messages copied into a buffer read() had handed back (kRecycledBytes).
+  std::uint64_t buffers_reused() const { return ahead_reused_.load(std::memory_order_relaxed); }
 
  private:
   /// One message read ahead: its bytes copied out of the reader's chunk.
@@ -174,6 +181,10 @@ class McapReplaySource final : public Source {
 
   // read-ahead: the reader thread fills ahead_, read() empties it into current_
   std::unique_ptr<SpscQueue<AheadMessage>> ahead_;
+  // ... and hands the bytes it is done with back, for the reader thread to copy the next message
+  // into: images are copied at 40 a second, and fresh half-megabyte blocks among the estimator's
+  // long-lived allocations left the heap larger after one pass of a looped replay than another.
+  std::unique_ptr<SpscQueue<std::vector<std::byte>>> spare_bytes_;
   std::atomic<bool> ahead_ended_{false};
   std::atomic<std::int64_t> ahead_base_log_ns_{0};  // log time of the newest message taken
   static constexpr std::int64_t kNoWake = std::numeric_limits<std::int64_t>::min();
@@ -181,6 +192,7 @@ class McapReplaySource final : public Source {
   std::atomic<std::int64_t> ahead_wake_reader_at_ns_{kNoWake};
   std::atomic<bool> ahead_consumer_waiting_{false};  // read() waits for a message
   std::atomic<std::uint64_t> ahead_pushed_{0};       // messages the reader queued
+  std::atomic<std::uint64_t> ahead_reused_{0};       // ... into a buffer handed back
   std::uint64_t ahead_taken_ = 0;                    // messages read() took (read()'s own)
   std::counting_semaphore<1 << 30> ahead_filled_{0}, ahead_room_{0};
   AheadMessage current_;

@@ -349,7 +349,7 @@ TEST(ChunkCache, ReadersOfOneFileShareDecompressedChunksAndNeverADamagedOne) {
   bytes[static_cast<std::size_t>(victim.start_offset + victim.chunk_length / 2 + 20)] ^=
       std::byte{0x55};
   McapReaderOptions options;
-  options.chunk_cache = std::make_shared<McapChunkCache>(4);
+  options.chunk_cache = std::make_shared<McapChunkCache>(4096);  // a few of its 1 kB chunks
   McapReader first, second;
   std::string error;
   ASSERT_TRUE(first.open_bytes(bytes, error, options)) << error;
@@ -386,7 +386,7 @@ TEST(ChunkCache, ReadersOfOneFileShareDecompressedChunksAndNeverADamagedOne) {
 }
 
 TEST(ChunkCache, AnEvictedChunksBufferIsReusedOnlyOnceNoReaderWalksIt) {
-  McapChunkCache cache(1);
+  McapChunkCache cache(1);  // the newest chunk only
   auto first = cache.buffer();
   first->resize(1000);
   const std::vector<std::byte>* const first_storage = first.get();
