@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <string>
@@ -28,6 +29,18 @@ int main(int argc, char** argv) noexcept try {
   // odometry nothing measurable (docs/realtime.md, stop 45). Before any thread exists; an
   // explicit MALLOC_ARENA_MAX in the environment wins.
   if (std::getenv("MALLOC_ARENA_MAX") == nullptr) ::mallopt(M_ARENA_MAX, 1);
+  // Blocks from 128 kB on (scans' point arrays, images, map messages) straight from the kernel
+  // and back to it when freed, not the heap: glibc's default threshold rises to the largest block
+  // freed, and megabyte blocks coming and going between long-lived small ones left freed pages
+  // resident in the heap, more every minute (the 60 s recording looped at recorded timing for 10
+  // minutes: +8.4 %; with this, flat). Costs +3.5 % of a core at recorded timing, and a
+  // --max-speed replay 5.62x -> 4.75x (docs/faults.md, stop 46). MALLOC_MMAP_THRESHOLD_ or
+  // GLIBC_TUNABLES in the environment win.
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (std::getenv("MALLOC_MMAP_THRESHOLD_") == nullptr &&
+      (tunables == nullptr || std::strstr(tunables, "mmap_threshold") == nullptr)) {
+    ::mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+  }
   posed::log::set_program_name("posed");
   CLI::App app{
       "posed: real-time driver-to-pose daemon. Reads the VLP-32C, D435i, PLUG 617 and A9 (or the\n"
