@@ -95,13 +95,14 @@ void print_mapping_summary(const pipeline::MappingFigures& m, const HostToWall& 
   std::printf(
       "                      candidates %llu by distance, %llu by descriptor, registered in "
       "%.1f ms on average; map -> odom %.3f m, %.2f deg; last optimisation %.3f s; keyframe "
-      "clouds %.1f M points (%.1f MB)%s\n",
+      "clouds %.1f M points (%.1f MB; %llu keyframes left theirs to a mapped place)%s\n",
       static_cast<unsigned long long>(f.distance_candidates),
       static_cast<unsigned long long>(f.descriptor_candidates),
       registrations > 0 ? 1e3 * f.registration_time_s / static_cast<double>(registrations) : 0.0,
       m.T_map_odom.translation().norm(),
       Eigen::AngleAxisd(m.T_map_odom.rotation()).angle() * 180.0 / M_PI, f.last_optimisation_s,
       static_cast<double>(f.stored_points) / 1e6, static_cast<double>(f.stored_bytes) / 1e6,
+      static_cast<unsigned long long>(f.mapped_keyframes),
       m.keyframes_dropped > 0 ? " (some keyframes dropped: the mapping thread fell behind)" : "");
 }
 

@@ -135,7 +135,11 @@ std::vector<std::size_t> Localiser::nearest_keyframes(const Eigen::Vector3d& cen
   std::vector<std::pair<double, std::size_t>> near;
   for (std::size_t i = 0; i < map_.keyframes.size(); ++i) {
     const double d = (map_.keyframes[i].T_map_base.translation() - centre_map_m).norm();
-    if (i != exclude && d <= config_.track_radius_m) near.emplace_back(d, i);
+    // A keyframe without a cloud left its place to an older one (LoopClosureConfig's
+    // mapped_keyframe_distance_m): nothing to register onto.
+    if (i != exclude && d <= config_.track_radius_m && map_.keyframes[i].points_base.size() > 0) {
+      near.emplace_back(d, i);
+    }
   }
   const std::size_t n = std::min(near.size(), cap);
   std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());

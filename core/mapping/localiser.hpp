@@ -92,8 +92,8 @@ class Localiser {
     Eigen::Isometry3d T_map_odom;
     RegistrationResult registration;
   };
-  /// The map keyframes within track_radius_m of `centre_map_m`, nearest first, at most `cap`,
-  /// without `exclude`.
+  /// The map keyframes with a cloud within track_radius_m of `centre_map_m`, nearest first, at
+  /// most `cap`, without `exclude`.
   std::vector<std::size_t> nearest_keyframes(const Eigen::Vector3d& centre_map_m, std::size_t cap,
                                              std::optional<std::size_t> exclude = {}) const;
   /// Registers the scan onto the map keyframes near `T_map_query_guess`; nullopt when none is

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/mapping/place_recognition.hpp"
 
@@ -70,6 +71,40 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
       index % static_cast<std::size_t>(config_.attempt_every_keyframes) == 0) {
     try_loop(index);
   }
+  drop_cloud_if_mapped(index);
+}
+
+void LoopCloser::drop_cloud_if_mapped(std::size_t query) {
+  if (config_.mapped_keyframe_distance_m <= 0 || loops_.empty() ||
+      query - loops_.back().query > static_cast<std::size_t>(config_.mapped_trust_keyframes)) {
+    return;
+  }
+  // Only keyframes old enough to be a loop count: the one before is always near.
+  if (!nearest_with_cloud(graph_.node(query), old_enough(query),
+                          config_.mapped_keyframe_distance_m)) {
+    return;
+  }
+  Keyframe& kf = keyframes_[query];
+  figures_.stored_points -= kf.points_base.size();
+  figures_.stored_bytes -= kf.points_base.bytes();
+  kf.points_base = CompactCloud();
+  ++figures_.mapped_keyframes;
+}
+
+std::optional<std::size_t> LoopCloser::nearest_with_cloud(const Eigen::Isometry3d& T_map,
+                                                          std::size_t eligible,
+                                                          double radius_m) const {
+  std::optional<std::size_t> best;
+  double best_distance = radius_m;
+  for (std::size_t i = 0; i < eligible; ++i) {
+    if (keyframes_[i].points_base.size() == 0) continue;
+    const double d = (graph_.node(i).translation() - T_map.translation()).norm();
+    if (d < best_distance) {
+      best_distance = d;
+      best = i;
+    }
+  }
+  return best;
 }
 
 std::size_t LoopCloser::old_enough(std::size_t query) const {
@@ -85,17 +120,12 @@ std::size_t LoopCloser::old_enough(std::size_t query) const {
 std::optional<LoopCloser::Candidate> LoopCloser::distance_candidate(std::size_t query,
                                                                     std::size_t eligible) const {
   const Eigen::Isometry3d T_map_query = graph_.node(query);
-  std::optional<Candidate> best;
-  double best_distance = config_.search_radius_m;
-  for (std::size_t i = 0; i < eligible; ++i) {
-    const Eigen::Isometry3d T_map_i = graph_.node(i);
-    const double d = (T_map_i.translation() - T_map_query.translation()).norm();
-    if (d < best_distance) {
-      best_distance = d;
-      best = Candidate{i, false, T_map_i.inverse() * T_map_query};
-    }
+  const std::optional<std::size_t> i =
+      nearest_with_cloud(T_map_query, eligible, config_.search_radius_m);
+  if (!i) {
+    return std::nullopt;
   }
-  return best;
+  return Candidate{*i, false, graph_.node(*i).inverse() * T_map_query};
 }
 
 std::optional<LoopCloser::Candidate> LoopCloser::descriptor_candidate(std::size_t query,
@@ -109,7 +139,18 @@ std::optional<LoopCloser::Candidate> LoopCloser::descriptor_candidate(std::size_
   if (!match) {
     return std::nullopt;
   }
-  return Candidate{match->index, true, match->T_match_query_guess};
+  if (keyframes_[match->index].points_base.size() > 0) {
+    return Candidate{match->index, true, match->T_match_query_guess};
+  }
+  // The place matched a keyframe that left its cloud to an older one nearby: register onto that.
+  const Eigen::Isometry3d T_map_match = graph_.node(match->index);
+  const std::optional<std::size_t> mapped =
+      nearest_with_cloud(T_map_match, eligible, config_.search_radius_m);
+  if (!mapped) {
+    return std::nullopt;
+  }
+  return Candidate{*mapped, true,
+                   graph_.node(*mapped).inverse() * T_map_match * match->T_match_query_guess};
 }
 
 std::vector<Eigen::Vector3f> LoopCloser::submap(std::size_t centre,
@@ -117,9 +158,28 @@ std::vector<Eigen::Vector3f> LoopCloser::submap(std::size_t centre,
   const std::size_t k = static_cast<std::size_t>(std::max(0, config_.submap_keyframes));
   const std::size_t first = centre > k ? centre - k : 0;
   const std::size_t last = std::min(centre + k, newest_allowed);
+  std::vector<std::size_t> members;
+  for (std::size_t i = first; i <= last; ++i) {
+    if (keyframes_[i].points_base.size() > 0) members.push_back(i);
+  }
+  // Keyframes in the window that left their cloud to an older one (a mapped place) are made up
+  // for by the keyframes with clouds nearest the centre, so the submap covers as much as before.
+  std::size_t missing = last - first + 1 - members.size();
+  if (missing > 0) {
+    const Eigen::Vector3d centre_m = graph_.node(centre).translation();
+    std::vector<std::pair<double, std::size_t>> near;
+    for (std::size_t i = 0; i <= newest_allowed; ++i) {
+      if ((i >= first && i <= last) || keyframes_[i].points_base.size() == 0) continue;
+      near.emplace_back((graph_.node(i).translation() - centre_m).norm(), i);
+    }
+    missing = std::min(missing, near.size());
+    std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(missing),
+                      near.end());
+    for (std::size_t k = 0; k < missing; ++k) members.push_back(near[k].second);
+  }
   const Eigen::Isometry3d T_centre_map = graph_.node(centre).inverse();
   std::vector<Eigen::Vector3f> points;
-  for (std::size_t i = first; i <= last; ++i) {
+  for (const std::size_t i : members) {
     const Eigen::Isometry3f T_centre_i = (T_centre_map * graph_.node(i)).cast<float>();
     for (const Eigen::Vector3f& p : keyframes_[i].points_base) {
       points.push_back(T_centre_i * p);

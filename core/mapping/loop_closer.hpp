@@ -35,6 +35,13 @@ struct LoopClosureConfig {
   double keyframe_angle_rad = 0.35;    ///< or turning this much [rad]
   double keyframe_voxel_m = 0.3;       ///< a keyframe's cloud is kept at this resolution [m]
   double keyframe_max_range_m = 60.0;  ///< points farther are not kept [m]
+  /// A keyframe this near an older one that keeps its cloud keeps only its pose, edges and
+  /// descriptor once its loop attempt is done, while a loop accepted within the last
+  /// mapped_trust_keyframes keyframes vouches that the graph has this place where the older
+  /// keyframe is: the place is mapped, and a patrol round it would otherwise grow the map by its
+  /// clouds every lap (docs/mapping.md, Memory). 0: every keyframe keeps its cloud [m]
+  double mapped_keyframe_distance_m = 1.5;
+  int mapped_trust_keyframes = 30;  ///< [1]
   /// loops are looked for at every n-th keyframe: registration is the expensive part [1]
   int attempt_every_keyframes = 2;
   /// after a loop is accepted, none is looked for over this many keyframes: a revisit would
@@ -96,6 +103,8 @@ struct LoopClosureFigures {
   double registration_time_s = 0;           ///< summed [s]
   std::size_t stored_points = 0;            ///< keyframe cloud points held [1]
   std::size_t stored_bytes = 0;             ///< what those points take [B]
+  /// keyframes that dropped their cloud: an older keyframe had the place mapped [1]
+  std::uint64_t mapped_keyframes = 0;
 };
 
 class LoopCloser {
@@ -121,6 +130,7 @@ class LoopCloser {
   Eigen::Isometry3d T_map_keyframe(std::size_t i) const { return graph_.node(i); }
   std::size_t keyframe_count() const { return keyframes_.size(); }
   HostTime keyframe_stamp(std::size_t i) const { return keyframes_.at(i).stamp; }
+  /// Keyframe i's cloud; empty when the place was mapped already (mapped_keyframe_distance_m).
   const CompactCloud& keyframe_points(std::size_t i) const { return keyframes_.at(i).points_base; }
 
   const LoopClosureFigures& figures() const { return figures_; }
@@ -157,7 +167,13 @@ class LoopCloser {
   /// `eligible`: old_enough(query).
   std::optional<Candidate> distance_candidate(std::size_t query, std::size_t eligible) const;
   std::optional<Candidate> descriptor_candidate(std::size_t query, std::size_t eligible) const;
+  /// The nearest keyframe among [0, eligible) to `T_map` that keeps its cloud, within `radius_m`.
+  std::optional<std::size_t> nearest_with_cloud(const Eigen::Isometry3d& T_map,
+                                                std::size_t eligible, double radius_m) const;
   std::vector<Eigen::Vector3f> submap(std::size_t centre, std::size_t newest_allowed) const;
+  /// Drops `query`'s cloud when an older keyframe has its place mapped and a recent loop vouches
+  /// for the graph there.
+  void drop_cloud_if_mapped(std::size_t query);
   void accept(const PoseGraphEdge& edge, const LoopRecord& record);
   void update_correction();
 

@@ -646,6 +646,11 @@ const Field kSchema[] = {
       "an odometry edge of the pose graph is this much less certain per metre the estimator "
       "matched degenerately (an open stretch), so loops correct the drift there; rotation gets a "
       "tenth of it in rad/m"),
+    F("mapping.mapped_keyframe_distance_m", mapping.mapped_keyframe_distance_m, "1.5", "m", 0, 100,
+      "",
+      "a keyframe this near an older keyframe that keeps its cloud, while a loop closed in the "
+      "last 30 keyframes vouches for the map there, keeps only its pose and descriptor: driving "
+      "a mapped place again does not grow the map; 0: every keyframe keeps its cloud"),
     F("mapping.localise_every_m", mapping.localise_every_m, "2", "m", 0.1, 100, "",
       "localising on a prior map (posed --map): once localised, register the scan onto the map "
       "after moving this far"),

@@ -314,6 +314,9 @@ struct MappingSection {
   int queue_capacity = 64;       ///< scans waiting for the mapping thread (live) [1]
   /// odometry edges between keyframes widen by this per metre of degenerate matching [m/m]
   double degenerate_sigma_per_m = 0.5;
+  /// a keyframe this near an older one with a cloud, while loops vouch for the map there, keeps
+  /// no cloud of its own: a patrol does not grow the map; 0: every keyframe keeps its cloud [m]
+  double mapped_keyframe_distance_m = 1.5;
   // Localisation on a prior map (posed --map DIR).
   double localise_every_m = 2.0;  ///< localised: a registration onto the map this often [m]
   double lost_after_m = 25.0;     ///< travel without a verified fix after which it is lost [m]

@@ -86,6 +86,7 @@ mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config
   c.keyframe_distance_m = config.estimator.keyframe_distance_m;
   c.keyframe_angle_rad = config.estimator.keyframe_angle_deg * M_PI / 180.0;
   c.keyframe_voxel_m = m.keyframe_voxel_m;
+  c.mapped_keyframe_distance_m = m.mapped_keyframe_distance_m;
   c.attempt_every_keyframes = m.attempt_every_keyframes;
   c.min_separation_s = m.min_separation_s;
   c.search_radius_m = m.search_radius_m;

@@ -89,6 +89,32 @@ TEST(Localiser, RelocalisesByDescriptorWithinTwoSecondsAndTracksTheMap) {
   EXPECT_LT(r.worst_error_m, 0.10) << "over " << r.scans_localised << " scans";
 }
 
+TEST(Localiser, RelocalisesOnAMapWhoseRevisitsKeptNoClouds) {
+  // The map a mapping run makes over the whole run, loops closed: the second lap's keyframes
+  // left their clouds to the first lap's (LoopClosureConfig::mapped_keyframe_distance_m), and a
+  // descriptor match onto one of them must still find clouds to register onto.
+  const sim::LidarImuRun& run = test::simulated("room", kRunSeconds);
+  LoopClosureConfig config;
+  config.min_separation_s = 15.0;
+  LoopCloser closer(config);
+  std::vector<Eigen::Vector3f> points_base;
+  for (const sim::DecodedScan& scan : run.scans) {
+    test::deskewed_base(run, scan, points_base);
+    closer.add(scan.end, run.T_map_base(scan.end), points_base);
+  }
+  ASSERT_GT(closer.figures().mapped_keyframes, 5u);
+  // Two keyframes a registration: the nearest to the robot are often the second lap's, and it
+  // must register onto the nearest that have clouds.
+  LocalisationConfig localisation;
+  localisation.track_keyframes = 2;
+  Localiser localiser(closer.snapshot(), localisation);
+  const Localised r = localise(run, localiser, test::pose(5, -5, 0.3, 1.75), 24.0, kRunSeconds);
+  ASSERT_TRUE(r.seconds_to_fix) << "lookups " << localiser.figures().lookups;
+  EXPECT_LE(*r.seconds_to_fix, 2.0);
+  EXPECT_GT(localiser.figures().fixes, 3u);
+  EXPECT_LT(r.worst_error_m, 0.10) << "over " << r.scans_localised << " scans";
+}
+
 TEST(Localiser, AnInitialPoseLocalisesAtTheFirstScan) {
   const sim::LidarImuRun& run = test::simulated("room", kRunSeconds);
   Localiser localiser(room_map(run), LocalisationConfig{});

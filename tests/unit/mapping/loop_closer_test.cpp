@@ -155,6 +155,75 @@ TEST(LoopCloser, FindsLoopsByDescriptorAloneWhenTheEstimateIsNoGuide) {
   EXPECT_LT(r.corrected_error_m, 0.4 * r.odometry_error_m);
 }
 
+TEST(LoopCloser, KeyframesInAMappedPlaceKeepNoCloudAndTheLoopsStillHold) {
+  // Three laps of the room: after the first loop, a keyframe near an older one that keeps its
+  // cloud drops its own, so laps after the first add poses, not points.
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  const DriftingOdometry odometry{.yaw_radps = 0.004, .drift_mps = 0.02};
+  LoopClosureConfig config;
+  config.min_separation_s = 15.0;
+  LoopClosureConfig keep_all = config;
+  keep_all.mapped_keyframe_distance_m = 0.0;
+  LoopCloser pruned(config);
+  const Replayed p = replay(run, odometry, pruned);
+  LoopCloser every(keep_all);
+  const Replayed e = replay(run, odometry, every);
+  const LoopClosureFigures& fp = pruned.figures();
+  const LoopClosureFigures& fe = every.figures();
+  std::printf(
+      "keyframes %llu, %llu without a cloud; points %zu (every cloud kept: %zu); loops %llu (%llu);"
+      " keyframe RMS %.3f m (%.3f m)\n",
+      static_cast<unsigned long long>(fp.keyframes),
+      static_cast<unsigned long long>(fp.mapped_keyframes), fp.stored_points, fe.stored_points,
+      static_cast<unsigned long long>(fp.loops), static_cast<unsigned long long>(fe.loops),
+      p.rms_corrected_keyframe_m, e.rms_corrected_keyframe_m);
+  EXPECT_EQ(fe.mapped_keyframes, 0u);
+  ASSERT_GT(fp.loops, 0u);
+  EXPECT_GT(fp.mapped_keyframes, fp.keyframes / 4);
+  EXPECT_LT(fp.stored_points, 0.8 * static_cast<double>(fe.stored_points));
+
+  // The figures count what the keyframes hold, and every keyframe without a cloud has an older
+  // one with a cloud where the graph puts it (the optimisations since may have moved both a bit).
+  std::size_t held = 0, held_bytes = 0;
+  for (std::size_t i = 0; i < pruned.keyframe_count(); ++i) {
+    held += pruned.keyframe_points(i).size();
+    held_bytes += pruned.keyframe_points(i).bytes();
+    if (pruned.keyframe_points(i).size() > 0) continue;
+    double nearest_m = 1e9;
+    for (std::size_t j = 0; j < i; ++j) {
+      if (pruned.keyframe_points(j).size() == 0) continue;
+      nearest_m = std::min(
+          nearest_m,
+          (pruned.T_map_keyframe(j).translation() - pruned.T_map_keyframe(i).translation()).norm());
+    }
+    EXPECT_LT(nearest_m, config.mapped_keyframe_distance_m + 0.3) << "keyframe " << i;
+  }
+  EXPECT_EQ(held, fp.stored_points);
+  EXPECT_EQ(held_bytes, fp.stored_bytes);
+
+  // Loops found onto the older clouds take the drift out as well as with every cloud kept.
+  EXPECT_LT(p.rms_corrected_keyframe_m, 0.4 * p.rms_odometry_keyframe_m);
+  EXPECT_LT(p.rms_corrected_keyframe_m, 1.25 * e.rms_corrected_keyframe_m + 0.02);
+  EXPECT_LT(p.corrected_error_m, 0.4 * p.odometry_error_m);
+}
+
+TEST(LoopCloser, NoKeyframeDropsItsCloudBeforeALoopVouchesForTheMap) {
+  // The same laps with every loop refused (no registration fits that well): a drifting
+  // estimate's "near an older keyframe" means nothing, so every cloud stays.
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  LoopClosureConfig config;
+  config.min_separation_s = 15.0;
+  config.registration.max_rms_m = 1e-6;
+  LoopCloser closer(config);
+  replay(run, DriftingOdometry{.yaw_radps = 0.004, .drift_mps = 0.02}, closer);
+  EXPECT_GT(closer.figures().distance_candidates, 5u);
+  EXPECT_EQ(closer.figures().loops, 0u);
+  EXPECT_EQ(closer.figures().mapped_keyframes, 0u);
+  for (std::size_t i = 0; i < closer.keyframe_count(); ++i) {
+    EXPECT_GT(closer.keyframe_points(i).size(), 0u) << "keyframe " << i;
+  }
+}
+
 TEST(LoopCloser, WithoutLoopsTheCorrectionStaysIdentity) {
   const sim::LidarImuRun& run = test::simulated("room", 60.0);
   LoopClosureConfig config;
