@@ -50,8 +50,23 @@ LidarStage::LidarStage(const config::PosedConfig& config, velodyne::Calibration 
                                      config.lidar.cut_azimuth_deg * 100)}},
                pool_) {}
 
+bool LidarStage::cut_by_silence(Duration stamp_to_arrival) const {
+  // The scan ended before the silence, give or take the few ms a scan's stamp and its closing
+  // packet's arrival are apart.
+  return silence_before_ > kMaxScanStampToArrival && stamp_to_arrival < Duration() &&
+         -stamp_to_arrival <= silence_before_ + kMaxScanStampToArrival;
+}
+
 void LidarStage::push_scan(LidarScan&& scan) {
   const Duration off = scan.end_stamp - chunk_received_;
+  if (chunk_received_.ns != 0 && cut_by_silence(off)) {
+    // By the time the data came back the estimate has gone on from the IMU: the scan is stale,
+    // not corrupt, and the stream is not degraded for it.
+    scan_counters_.cut_by_silence.fetch_add(1, std::memory_order_relaxed);
+    POSED_LOG_INFO("lidar: the scan in progress when the data stopped %.2f s ago is left out",
+                   -off.seconds());
+    return;
+  }
   if (chunk_received_.ns != 0 && (off > kMaxScanStampToArrival || off < -kMaxScanStampToArrival)) {
     if (scan_counters_.implausible.fetch_add(1, std::memory_order_relaxed) == 0) {
       POSED_LOG_WARN(
@@ -104,6 +119,9 @@ void LidarStage::handle_position(const drivers::RawChunk& chunk) {
 }
 
 void LidarStage::handle_data(const drivers::RawChunk& chunk) {
+  silence_before_ =
+      previous_data_received_.ns != 0 ? chunk.host_receive - previous_data_received_ : Duration();
+  previous_data_received_ = chunk.host_receive;
   if (builder_.add_data(chunk.bytes, chunk.host_receive) != velodyne::DecodeStatus::kOk) {
     counters_.malformed.store(builder_.decoder().counters().malformed(), std::memory_order_relaxed);
     return;

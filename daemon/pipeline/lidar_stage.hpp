@@ -27,6 +27,9 @@ struct LidarScanCounters {
   /// scans left out: stamped further from their arrival than kMaxScanStampToArrival (a corrupt
   /// device time the clock sync followed); counted as dropped too
   std::atomic<std::uint64_t> implausible{0};
+  /// scans left out because the lidar fell silent while they were open: the first packet after
+  /// the silence closes them, stamped the silence's length ago (stale, not corrupt; not dropped)
+  std::atomic<std::uint64_t> cut_by_silence{0};
 };
 
 /// A scan's end stamp and the arrival of the packet that closed it are a few ms apart (the
@@ -55,6 +58,9 @@ class LidarStage {
   /// One serialized sensor_msgs/PointCloud2 (lidar_stage_ros1.cpp).
   void handle_ros1_cloud(const drivers::RawChunk& chunk);
   void push_scan(LidarScan&& scan);
+  /// Whether `scan` is the one that was open when the lidar fell silent: its stamp is as old as
+  /// the silence before the packet that closed it.
+  bool cut_by_silence(Duration stamp_to_arrival) const;
   void forward_scans();
 
   const config::PosedConfig& config_;
@@ -80,6 +86,10 @@ class LidarStage {
   std::optional<HostTime> pps_lost_at_;
   /// the Source's receive stamp of the chunk being handled (a scan's is its last packet's)
   HostTime chunk_received_;
+  /// the receive stamp of the data packet before the one being handled
+  HostTime previous_data_received_;
+  /// how long the lidar had been silent before the data packet being handled [s]
+  Duration silence_before_;
 };
 
 }  // namespace posed::pipeline

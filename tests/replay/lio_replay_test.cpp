@@ -179,6 +179,12 @@ TEST(LioReplay, ALidarOutageIsReportedInTheDataTimeAndTheOdometryCarriesOnThroug
   EXPECT_GE(back_s, 5.95) << posed.err();
   EXPECT_LE(back_s, 6.3) << posed.err();
   EXPECT_EQ(posed.err().find("stream imu:"), std::string::npos) << posed.err();
+  // The scan that was open when the lidar fell silent is stale when the first packet after the
+  // silence closes it: left out, said so, and neither a corrupt device time nor a degraded stream.
+  EXPECT_NE(posed.err().find("the scan in progress when the data stopped"), std::string::npos)
+      << posed.err();
+  EXPECT_EQ(posed.err().find("stream lidar: ok -> degraded"), std::string::npos) << posed.err();
+  EXPECT_EQ(posed.err().find("corrupt device time"), std::string::npos) << posed.err();
 
   // The odometry went on through the silence (IMU propagation).
   const auto odom = recorded_poses(dir.file("out.mcap"), "/posed/odom", true);
