@@ -84,10 +84,13 @@ void LoopCloser::drop_cloud_if_mapped(std::size_t query) {
                           config_.mapped_keyframe_distance_m)) {
     return;
   }
+  // Its descriptor goes too: the older keyframe's describes the same place, and a match here
+  // would have no cloud to register onto.
   Keyframe& kf = keyframes_[query];
   figures_.stored_points -= kf.points_base.size();
   figures_.stored_bytes -= kf.points_base.bytes();
   kf.points_base = CompactCloud();
+  kf.context = ScanContext();
   ++figures_.mapped_keyframes;
 }
 
@@ -139,18 +142,8 @@ std::optional<LoopCloser::Candidate> LoopCloser::descriptor_candidate(std::size_
   if (!match) {
     return std::nullopt;
   }
-  if (keyframes_[match->index].points_base.size() > 0) {
-    return Candidate{match->index, true, match->T_match_query_guess};
-  }
-  // The place matched a keyframe that left its cloud to an older one nearby: register onto that.
-  const Eigen::Isometry3d T_map_match = graph_.node(match->index);
-  const std::optional<std::size_t> mapped =
-      nearest_with_cloud(T_map_match, eligible, config_.search_radius_m);
-  if (!mapped) {
-    return std::nullopt;
-  }
-  return Candidate{*mapped, true,
-                   graph_.node(*mapped).inverse() * T_map_match * match->T_match_query_guess};
+  // (A keyframe without a cloud has no descriptor either: every match has a cloud.)
+  return Candidate{match->index, true, match->T_match_query_guess};
 }
 
 std::vector<Eigen::Vector3f> LoopCloser::submap(std::size_t centre,

@@ -35,8 +35,8 @@ struct LoopClosureConfig {
   double keyframe_angle_rad = 0.35;    ///< or turning this much [rad]
   double keyframe_voxel_m = 0.3;       ///< a keyframe's cloud is kept at this resolution [m]
   double keyframe_max_range_m = 60.0;  ///< points farther are not kept [m]
-  /// A keyframe this near an older one that keeps its cloud keeps only its pose, edges and
-  /// descriptor once its loop attempt is done, while a loop accepted within the last
+  /// A keyframe this near an older one that keeps its cloud keeps only its pose and edges (no
+  /// cloud, no descriptor) once its loop attempt is done, while a loop accepted within the last
   /// mapped_trust_keyframes keyframes vouches that the graph has this place where the older
   /// keyframe is: the place is mapped, and a patrol round it would otherwise grow the map by its
   /// clouds every lap (docs/mapping.md, Memory). 0: every keyframe keeps its cloud [m]
@@ -103,7 +103,7 @@ struct LoopClosureFigures {
   double registration_time_s = 0;           ///< summed [s]
   std::size_t stored_points = 0;            ///< keyframe cloud points held [1]
   std::size_t stored_bytes = 0;             ///< what those points take [B]
-  /// keyframes that dropped their cloud: an older keyframe had the place mapped [1]
+  /// keyframes that dropped their cloud and descriptor: an older keyframe had the place mapped [1]
   std::uint64_t mapped_keyframes = 0;
 };
 
@@ -130,7 +130,8 @@ class LoopCloser {
   Eigen::Isometry3d T_map_keyframe(std::size_t i) const { return graph_.node(i); }
   std::size_t keyframe_count() const { return keyframes_.size(); }
   HostTime keyframe_stamp(std::size_t i) const { return keyframes_.at(i).stamp; }
-  /// Keyframe i's cloud; empty when the place was mapped already (mapped_keyframe_distance_m).
+  /// Keyframe i's cloud; empty when the place was mapped already (mapped_keyframe_distance_m),
+  /// and then its descriptor is empty too.
   const CompactCloud& keyframe_points(std::size_t i) const { return keyframes_.at(i).points_base; }
 
   const LoopClosureFigures& figures() const { return figures_; }
@@ -171,8 +172,8 @@ class LoopCloser {
   std::optional<std::size_t> nearest_with_cloud(const Eigen::Isometry3d& T_map,
                                                 std::size_t eligible, double radius_m) const;
   std::vector<Eigen::Vector3f> submap(std::size_t centre, std::size_t newest_allowed) const;
-  /// Drops `query`'s cloud when an older keyframe has its place mapped and a recent loop vouches
-  /// for the graph there.
+  /// Drops `query`'s cloud and descriptor when an older keyframe has its place mapped and a recent
+  /// loop vouches for the graph there.
   void drop_cloud_if_mapped(std::size_t query);
   void accept(const PoseGraphEdge& edge, const LoopRecord& record);
   void update_correction();

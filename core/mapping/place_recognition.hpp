@@ -42,7 +42,8 @@ struct DescriptorMatch {
 };
 
 /// The best Scan Context match below `max_distance` among keyframes [0, count):
-/// `context_of(i)` and `level_of(i)` give keyframe i's descriptor and R_level_base.
+/// `context_of(i)` and `level_of(i)` give keyframe i's descriptor and R_level_base. Keyframes
+/// without a descriptor (a place an older keyframe maps) are passed over.
 template <class ContextOf, class LevelOf>
 std::optional<DescriptorMatch> best_descriptor_match(const ScanContext& query,
                                                      const Eigen::Matrix3d& R_level_query,
@@ -54,7 +55,9 @@ std::optional<DescriptorMatch> best_descriptor_match(const ScanContext& query,
   std::vector<std::pair<float, std::size_t>> by_ring_key;
   by_ring_key.reserve(count);
   for (std::size_t i = 0; i < count; ++i) {
-    by_ring_key.emplace_back((context_of(i).ring_key - query.ring_key).squaredNorm(), i);
+    const ScanContext& c = context_of(i);
+    if (c.ring_key.size() != query.ring_key.size()) continue;
+    by_ring_key.emplace_back((c.ring_key - query.ring_key).squaredNorm(), i);
   }
   const auto n =
       std::min<std::size_t>(by_ring_key.size(), static_cast<std::size_t>(ring_key_candidates));

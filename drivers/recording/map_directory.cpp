@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "drivers/recording/map_files.hpp"
 
@@ -95,8 +96,15 @@ bool write_scan_contexts(const std::string& path, const mapping::KeyframeMap& ma
     if (std::fwrite(kScanContextMagic, 1, 8, f) != 8 || std::fwrite(header, 4, 3, f) != 3) {
       return false;
     }
+    // A keyframe without a descriptor (its place is mapped by an older one) is written as zeros:
+    // no bin of a real descriptor is 0 everywhere, and the reader takes zeros back as none.
+    const std::vector<float> none(std::size_t{rings} * sectors + rings + sectors, 0.0f);
     for (const mapping::MapKeyframe& kf : map.keyframes) {
       const mapping::ScanContext& sc = kf.context;
+      if (sc.bins.size() == 0) {
+        if (!write_floats(f, none.data(), none.size())) return false;
+        continue;
+      }
       if (sc.bins.rows() != static_cast<Eigen::Index>(rings) ||
           sc.bins.cols() != static_cast<Eigen::Index>(sectors)) {
         errno = EINVAL;
@@ -348,6 +356,9 @@ bool read_scan_contexts(const std::string& path, mapping::KeyframeMap& map, std:
                  "truncated in descriptor " + std::to_string(i) + " (byte " +
                      std::to_string(offset) + ")");
       return false;
+    }
+    if (sc.bins.isZero(0) && sc.ring_key.isZero(0) && sc.sector_key.isZero(0)) {
+      sc = mapping::ScanContext();  // written as none (write_scan_contexts)
     }
   }
   return true;

@@ -200,6 +200,12 @@ TEST(LoopCloser, KeyframesInAMappedPlaceKeepNoCloudAndTheLoopsStillHold) {
   }
   EXPECT_EQ(held, fp.stored_points);
   EXPECT_EQ(held_bytes, fp.stored_bytes);
+  // A keyframe without a cloud has no descriptor either; one with a cloud keeps its descriptor.
+  const KeyframeMap map = pruned.snapshot();
+  for (std::size_t i = 0; i < map.keyframes.size(); ++i) {
+    EXPECT_EQ(map.keyframes[i].points_base.size() == 0, map.keyframes[i].context.bins.size() == 0)
+        << "keyframe " << i;
+  }
 
   // Loops found onto the older clouds take the drift out as well as with every cloud kept.
   EXPECT_LT(p.rms_corrected_keyframe_m, 0.4 * p.rms_odometry_keyframe_m);
