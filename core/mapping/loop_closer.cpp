@@ -168,7 +168,7 @@ std::vector<Eigen::Vector3f> LoopCloser::submap(std::size_t centre,
     missing = std::min(missing, near.size());
     std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(missing),
                       near.end());
-    for (std::size_t k = 0; k < missing; ++k) members.push_back(near[k].second);
+    for (std::size_t n = 0; n < missing; ++n) members.push_back(near[n].second);
   }
   const Eigen::Isometry3d T_centre_map = graph_.node(centre).inverse();
   std::vector<Eigen::Vector3f> points;
