@@ -39,15 +39,20 @@ struct Written {
   std::uint32_t messages = 0;
 };
 
-Written write_file(const std::string& path, McapCompression compression, std::uint32_t n,
-                   std::size_t chunk_size = 2048) {
+/// A test file's writer options: `compression`, chunks of `chunk_bytes`, no fsync.
+McapWriterOptions writer_options(McapCompression compression, std::size_t chunk_bytes) {
   McapWriterOptions opt;
   opt.compression = compression;
-  opt.chunk_size_bytes = chunk_size;
+  opt.chunk_size_bytes = chunk_bytes;
   opt.fsync_on_close = false;
+  return opt;
+}
+
+Written write_file(const std::string& path, McapCompression compression, std::uint32_t n,
+                   std::size_t chunk_size = 2048) {
   McapWriter w;
   std::string error;
-  EXPECT_TRUE(w.open(path, opt, error)) << error;
+  EXPECT_TRUE(w.open(path, writer_options(compression, chunk_size), error)) << error;
   const std::string text = "int32 a\n";
   const auto sid = w.add_schema("t/msg/A", "ros2msg",
                                 {reinterpret_cast<const std::byte*>(text.data()), text.size()});
@@ -101,13 +106,9 @@ std::size_t mapped_resident_kb(const std::string& path) {
 void write_large_file(const std::string& path, McapCompression compression, std::size_t chunk_bytes,
                       std::size_t message_bytes,
                       const std::function<void(std::uint32_t, std::vector<std::byte>&)>& fill) {
-  McapWriterOptions opt;
-  opt.compression = compression;
-  opt.chunk_size_bytes = chunk_bytes;
-  opt.fsync_on_close = false;
   McapWriter w;
   std::string error;
-  ASSERT_TRUE(w.open(path, opt, error)) << error;
+  ASSERT_TRUE(w.open(path, writer_options(compression, chunk_bytes), error)) << error;
   const auto ch = w.add_channel("/raw", "posed-raw", 0, {});
   std::vector<std::byte> bytes(message_bytes);
   for (std::uint32_t i = 0; i < 1024; ++i) {
