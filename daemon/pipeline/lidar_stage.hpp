@@ -58,8 +58,8 @@ class LidarStage {
   /// One serialized sensor_msgs/PointCloud2 (lidar_stage_ros1.cpp).
   void handle_ros1_cloud(const drivers::RawChunk& chunk);
   void push_scan(LidarScan&& scan);
-  /// Whether `scan` is the one that was open when the lidar fell silent: its stamp is as old as
-  /// the silence before the packet that closed it.
+  /// Whether a scan stamped `stamp_to_arrival` from the packet that closed it is the one that was
+  /// open when the lidar fell silent: its stamp is as old as the silence before that packet.
   bool cut_by_silence(Duration stamp_to_arrival) const;
   void forward_scans();
 
