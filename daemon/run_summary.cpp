@@ -193,14 +193,22 @@ bool print_run_summary(const RunSummary& r) {
                 static_cast<unsigned long long>(dropped));
   }
   if (r.has_lidar) {
+    // Scans left out before the fusion core, said only when there were any: a scan open when
+    // the lidar fell silent (stale), or stamped a second or more from its arrival (corrupt time).
+    std::string left_out;
+    if (st.lidar_scans_cut_by_silence + st.lidar_scans_implausible > 0) {
+      left_out = "; left out: " + std::to_string(st.lidar_scans_cut_by_silence) +
+                 " open when the data stopped, " + std::to_string(st.lidar_scans_implausible) +
+                 " stamped implausibly";
+    }
     std::printf(
         "  lidar scans         %llu assembled (%.0f points/scan mean), %llu reached the "
-        "fusion core, %llu used by the estimator\n",
+        "fusion core, %llu used by the estimator%s\n",
         static_cast<unsigned long long>(st.lidar_scans),
         st.lidar_scans ? static_cast<double>(st.lidar_points) / static_cast<double>(st.lidar_scans)
                        : 0.0,
         static_cast<unsigned long long>(st.lidar_scans_fused),
-        static_cast<unsigned long long>(st.estimator.scans_used));
+        static_cast<unsigned long long>(st.estimator.scans_used), left_out.c_str());
   }
   if (r.has_lidar) {
     const FusionFigures& f = st.estimator;

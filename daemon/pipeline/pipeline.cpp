@@ -445,6 +445,8 @@ PipelineStatus Pipeline::status() const {
     st.streams.push_back(std::move(lidar));
     st.lidar_scans = scan_counters_->scans.load();
     st.lidar_points = scan_counters_->points.load();
+    st.lidar_scans_cut_by_silence = scan_counters_->cut_by_silence.load();
+    st.lidar_scans_implausible = scan_counters_->implausible.load();
     st.lidar_scans_fused = fusion_counters_->scans_fused.load();
   }
   for (const CameraStream s : kCameraStreams) {

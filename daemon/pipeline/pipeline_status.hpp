@@ -50,8 +50,12 @@ struct PipelineStatus {
   HostTime stamp;
   EstimatorMode mode = EstimatorMode::kAligning;
   std::vector<StreamStatus> streams;
-  std::uint64_t lidar_scans = 0;        ///< scans assembled
-  std::uint64_t lidar_points = 0;       ///< points in those scans
+  std::uint64_t lidar_scans = 0;   ///< scans assembled
+  std::uint64_t lidar_points = 0;  ///< points in those scans
+  /// scans left out as stale: open when the lidar fell silent (LidarScanCounters::cut_by_silence)
+  std::uint64_t lidar_scans_cut_by_silence = 0;
+  /// scans left out as stamped implausibly far from their arrival (LidarScanCounters::implausible)
+  std::uint64_t lidar_scans_implausible = 0;
   std::uint64_t lidar_scans_fused = 0;  ///< scans the fusion core received
   /// camera frames the fusion core received, by CameraStream (visible, thermal)
   std::uint64_t camera_frames_fused[3] = {0, 0, 0};

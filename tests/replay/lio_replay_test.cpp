@@ -185,6 +185,10 @@ TEST(LioReplay, ALidarOutageIsReportedInTheDataTimeAndTheOdometryCarriesOnThroug
       << posed.err();
   EXPECT_EQ(posed.err().find("stream lidar: ok -> degraded"), std::string::npos) << posed.err();
   EXPECT_EQ(posed.err().find("corrupt device time"), std::string::npos) << posed.err();
+  // The summary counts it where a person looks for lost scans.
+  EXPECT_NE(posed.out().find("left out: 1 open when the data stopped, 0 stamped implausibly"),
+            std::string::npos)
+      << posed.out();
 
   // The odometry went on through the silence (IMU propagation).
   const auto odom = recorded_poses(dir.file("out.mcap"), "/posed/odom", true);
