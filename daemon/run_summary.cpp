@@ -83,14 +83,16 @@ void print_mapping_summary(const pipeline::MappingFigures& m, const HostToWall& 
   };
   std::printf(
       "  loops               %llu closed (%llu by descriptor) over %llu keyframes; refused: %llu "
-      "degenerate, %llu not close, %llu low overlap, %llu diverged, %llu unconfirmed\n",
+      "degenerate, %llu not close, %llu low overlap, %llu diverged, %llu unconfirmed, %llu "
+      "implausible\n",
       static_cast<unsigned long long>(f.loops), static_cast<unsigned long long>(by_descriptor),
       static_cast<unsigned long long>(f.keyframes),
       refused(mapping::RegistrationVerdict::kDegenerate),
       refused(mapping::RegistrationVerdict::kNotClose),
       refused(mapping::RegistrationVerdict::kLowOverlap),
       refused(mapping::RegistrationVerdict::kDiverged),
-      static_cast<unsigned long long>(f.unconfirmed));
+      static_cast<unsigned long long>(f.unconfirmed),
+      static_cast<unsigned long long>(f.implausible));
   const std::uint64_t registrations = f.distance_candidates + f.descriptor_candidates;
   std::printf(
       "                      candidates %llu by distance, %llu by descriptor, registered in "

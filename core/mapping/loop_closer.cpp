@@ -15,6 +15,24 @@ double angle_of(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle();
 
 double seconds_between(HostTime a, HostTime b) { return static_cast<double>(b.ns - a.ns) * 1e-9; }
 
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+/// Adjoint of T for perturbations [translation, rotation]: T exp(xi) T^-1 = exp(Ad(T) xi).
+Matrix6d adjoint(const Eigen::Isometry3d& T) {
+  Matrix6d ad = Matrix6d::Zero();
+  ad.topLeftCorner<3, 3>() = T.rotation();
+  ad.topRightCorner<3, 3>() = skew(T.translation()) * T.rotation();
+  ad.bottomRightCorner<3, 3>() = T.rotation();
+  return ad;
+}
+
 }  // namespace
 
 LoopCloser::LoopCloser(LoopClosureConfig config)
@@ -64,6 +82,8 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
                                share * config_.odometry_sigma_rotation_degenerate_per_m) *
                                   d;
     graph_.add_edge(edge);
+    kf.edge_sigma_translation_m = edge.sigma_translation_m;
+    kf.edge_sigma_rotation_rad = edge.sigma_rotation_rad;
   }
   keyframes_.push_back(std::move(kf));
   figures_.keyframes = keyframes_.size();
@@ -226,6 +246,13 @@ void LoopCloser::try_loop(std::size_t query) {
   record.overlap = reg.overlap;
   record.constraint = reg.constraint;
   record.correction_m = (T_map_query_loop.translation() - T_map_query.translation()).norm();
+  record.correction_sigmas = correction_sigmas(candidate->index, query, reg.T_target_source);
+  if (config_.loop_max_correction_sigmas > 0 &&
+      record.correction_sigmas > config_.loop_max_correction_sigmas) {
+    ++figures_.implausible;
+    last_implausible_ = record;
+    return;
+  }
 
   if (!candidate->by_descriptor || record.correction_m <= config_.search_radius_m) {
     pending_.reset();
@@ -251,6 +278,34 @@ void LoopCloser::try_loop(std::size_t query) {
     ++figures_.unconfirmed;
   }
   pending_ = Pending{query, T_map_query_loop, edge, record};
+}
+
+double LoopCloser::correction_sigmas(std::size_t candidate, std::size_t query,
+                                     const Eigen::Isometry3d& T_candidate_query) const {
+  // The covariance of a right perturbation of T_candidate_i, carried along the odometry edges:
+  // each moves the perturbation so far into its own end's frame and adds its own.
+  Matrix6d covariance = Matrix6d::Zero();
+  for (std::size_t i = candidate + 1; i <= query; ++i) {
+    const Keyframe& kf = keyframes_[i];
+    const Eigen::Isometry3d T_i_previous = kf.T_odom_base.inverse() * keyframes_[i - 1].T_odom_base;
+    const Matrix6d ad = adjoint(T_i_previous);
+    covariance = ad * covariance * ad.transpose();
+    covariance.diagonal().head<3>().array() +=
+        kf.edge_sigma_translation_m * kf.edge_sigma_translation_m;
+    covariance.diagonal().tail<3>().array() +=
+        kf.edge_sigma_rotation_rad * kf.edge_sigma_rotation_rad;
+  }
+  covariance.diagonal().head<3>().array() +=
+      config_.loop_sigma_translation_m * config_.loop_sigma_translation_m;
+  covariance.diagonal().tail<3>().array() +=
+      config_.loop_sigma_rotation_rad * config_.loop_sigma_rotation_rad;
+  const Eigen::Isometry3d T_graph = graph_.node(candidate).inverse() * graph_.node(query);
+  const Eigen::Isometry3d delta = T_graph.inverse() * T_candidate_query;
+  const Eigen::AngleAxisd rotation(delta.rotation());
+  Vector6d error;
+  error.head<3>() = delta.translation();
+  error.tail<3>() = rotation.angle() * rotation.axis();
+  return std::sqrt(std::max(0.0, error.dot(covariance.ldlt().solve(error))));
 }
 
 void LoopCloser::accept(const PoseGraphEdge& edge, const LoopRecord& record) {

@@ -72,6 +72,14 @@ struct LoopClosureConfig {
   double odometry_sigma_rotation_degenerate_per_m = 0.0;
   double loop_sigma_translation_m = 0.05;
   double loop_sigma_rotation_rad = 0.01;
+  /// A verified loop whose correction lies further than this from where the graph puts the
+  /// query, in sigmas of the odometry edges chained from the candidate to the query (plus the
+  /// loop edge's own), is refused as implausible: another place that looks like this one fits
+  /// its registration as well as the true one does, but it asks the odometry for a drift its
+  /// model rules out (campus seed 47: a descriptor match 74 m away, both keyframes' scans fitting
+  /// at 0.06 m, asked for a 40 deg turn: 12.6 sigma; a true loop after the odometry had run
+  /// off by 85 m on seed 48: 5.3 sigma). 0: no such test [sigma]
+  double loop_max_correction_sigmas = 8.0;
   /// Cauchy scale on loop edges [sigma]; 0: none. Off by default: a true loop after long drift
   /// starts hundreds of sigmas off and a robust loss would discard it as an outlier; the
   /// registration's tests and the descriptor confirmation are what keep wrong loops out.
@@ -88,6 +96,9 @@ struct LoopRecord {
   double overlap = 0;       ///< registration overlap [0..1]
   double constraint = 0;    ///< weakest direction's information share [0..1]
   double correction_m = 0;  ///< how far the loop moved the query from the graph's estimate [m]
+  /// that correction in sigmas of the odometry chained from the candidate (loop_closer.hpp,
+  /// loop_max_correction_sigmas) [sigma]
+  double correction_sigmas = 0;
 };
 
 struct LoopClosureFigures {
@@ -97,6 +108,8 @@ struct LoopClosureFigures {
   std::uint64_t descriptor_candidates = 0;  ///< [1]
   std::uint64_t loops = 0;                  ///< accepted [1]
   std::uint64_t unconfirmed = 0;            ///< descriptor loops the next attempt contradicted
+  /// verified loops refused for a correction the odometry cannot have drifted by [1]
+  std::uint64_t implausible = 0;
   std::array<std::uint64_t, 6> rejected{};  ///< by RegistrationVerdict [1]
   std::uint64_t optimisations = 0;          ///< [1]
   double last_optimisation_s = 0;           ///< [s]
@@ -136,6 +149,8 @@ class LoopCloser {
 
   const LoopClosureFigures& figures() const { return figures_; }
   const std::vector<LoopRecord>& loops() const { return loops_; }
+  /// The last loop refused as implausible (loop_max_correction_sigmas), for the log.
+  const std::optional<LoopRecord>& last_implausible() const { return last_implausible_; }
   const PoseGraph& graph() const { return graph_; }
   /// The map as it stands: every keyframe at its optimised pose, with its cloud and descriptor,
   /// and the graph's edges (stamp_ns: the keyframes' HostTime; a writer may restamp them).
@@ -148,6 +163,9 @@ class LoopCloser {
     Eigen::Matrix3d R_level_base;  ///< removes roll and pitch: the Scan Context's frame
     CompactCloud points_base;
     ScanContext context;
+    /// sigmas of the odometry edge from the keyframe before (none for the first) [m], [rad]
+    double edge_sigma_translation_m = 0;
+    double edge_sigma_rotation_rad = 0;
   };
   struct Candidate {
     std::size_t index = 0;
@@ -175,6 +193,10 @@ class LoopCloser {
   /// Drops `query`'s cloud and descriptor when an older keyframe has its place mapped and a recent
   /// loop vouches for the graph there.
   void drop_cloud_if_mapped(std::size_t query);
+  /// How far `T_candidate_query` (a registration) lies from the graph's relative pose of the
+  /// two keyframes, in sigmas of the odometry edges between them and the loop edge [sigma].
+  double correction_sigmas(std::size_t candidate, std::size_t query,
+                           const Eigen::Isometry3d& T_candidate_query) const;
   void accept(const PoseGraphEdge& edge, const LoopRecord& record);
   void update_correction();
 
@@ -187,6 +209,7 @@ class LoopCloser {
   std::size_t next_attempt_ = 0;  ///< no attempt before this keyframe index (cooldown)
   LoopClosureFigures figures_;
   std::vector<LoopRecord> loops_;
+  std::optional<LoopRecord> last_implausible_;
 };
 
 }  // namespace posed::mapping

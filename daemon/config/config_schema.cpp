@@ -644,8 +644,15 @@ const Field kSchema[] = {
       "(counted; the graph bridges it by odometry), a replay waits"),
     F("mapping.degenerate_sigma_per_m", mapping.degenerate_sigma_per_m, "0.5", "m/m", 0, 10, "",
       "an odometry edge of the pose graph is this much less certain per metre the estimator "
-      "matched degenerately (an open stretch), so loops correct the drift there; rotation gets a "
-      "tenth of it in rad/m"),
+      "matched degenerately (an open stretch), so loops correct the drift there"),
+    F("mapping.degenerate_rotation_sigma_per_m", mapping.degenerate_rotation_sigma_per_m, "0.05",
+      "rad/m", 0, 10, "", "and its rotation this much less certain per such metre"),
+    F("mapping.loop_max_correction_sigmas", mapping.loop_max_correction_sigmas, "8", "sigma", 0,
+      1e6, "",
+      "a verified loop is refused as implausible when its correction is further than this from "
+      "where the graph puts the keyframe, in sigmas of the odometry edges between the two "
+      "keyframes: a place that looks like another fits as well but asks for a drift the odometry "
+      "cannot have; 0: no such test"),
     F("mapping.mapped_keyframe_distance_m", mapping.mapped_keyframe_distance_m, "1.5", "m", 0, 100,
       "",
       "a keyframe this near an older keyframe that keeps its cloud, while a loop closed in the "

@@ -314,6 +314,8 @@ struct MappingSection {
   int queue_capacity = 64;       ///< scans waiting for the mapping thread (live) [1]
   /// odometry edges between keyframes widen by this per metre of degenerate matching [m/m]
   double degenerate_sigma_per_m = 0.5;
+  double degenerate_rotation_sigma_per_m = 0.05;  ///< [rad/m]
+  double loop_max_correction_sigmas = 8;          ///< [sigma]; 0: no plausibility test
   /// a keyframe this near an older one with a cloud, while loops vouch for the map there, keeps
   /// no cloud of its own: a patrol does not grow the map; 0: every keyframe keeps its cloud [m]
   double mapped_keyframe_distance_m = 1.5;

@@ -95,7 +95,8 @@ mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config
   c.registration.min_overlap = m.min_overlap;
   c.registration.min_constraint = m.min_constraint;
   c.odometry_sigma_translation_degenerate_per_m = m.degenerate_sigma_per_m;
-  c.odometry_sigma_rotation_degenerate_per_m = 0.1 * m.degenerate_sigma_per_m;
+  c.odometry_sigma_rotation_degenerate_per_m = m.degenerate_rotation_sigma_per_m;
+  c.loop_max_correction_sigmas = m.loop_max_correction_sigmas;
   return c;
 }
 

@@ -156,6 +156,7 @@ bool MappingStage::take(Item& item) {
     return changed;
   }
   const std::size_t loops_before = closer_.loops().size();
+  const std::uint64_t implausible_before = closer_.figures().implausible;
   if (item.has_scan) {
     closer_.add_keyframe(item.stamp, item.T_odom_base, item.points_base, item.degenerate_share);
   }
@@ -176,10 +177,20 @@ bool MappingStage::take(Item& item) {
     const mapping::LoopRecord& loop = closer_.loops()[i];
     POSED_LOG_NOTICE(
         "mapping: loop %zu at %.3f s: keyframe %zu -> %zu (%s), fit %.3f m, overlap %.2f, "
-        "correction %.2f m; map -> odom now %.2f m off",
+        "correction %.2f m (%.1f sigma); map -> odom now %.2f m off",
         i + 1, loop.stamp.seconds(), loop.query, loop.candidate,
         loop.by_descriptor ? "descriptor" : "distance", loop.rms_m, loop.overlap, loop.correction_m,
-        closer_.T_map_odom().translation().norm());
+        loop.correction_sigmas, closer_.T_map_odom().translation().norm());
+  }
+  if (closer_.figures().implausible != implausible_before && closer_.last_implausible()) {
+    const mapping::LoopRecord& loop = *closer_.last_implausible();
+    POSED_LOG_NOTICE(
+        "mapping: loop refused at %.3f s: keyframe %zu -> %zu (%s) fits (%.3f m, overlap %.2f) "
+        "but asks for a correction of %.2f m, %.1f sigma of the odometry between them: another "
+        "place like this one?",
+        loop.stamp.seconds(), loop.query, loop.candidate,
+        loop.by_descriptor ? "descriptor" : "distance", loop.rms_m, loop.overlap, loop.correction_m,
+        loop.correction_sigmas);
   }
   return loops_now != loops_before;
 }

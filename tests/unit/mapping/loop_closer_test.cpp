@@ -86,10 +86,20 @@ Replayed replay(const sim::LidarImuRun& run, const DriftingOdometry& odometry, L
   return out;
 }
 
-TEST(LoopCloser, ClosesTheRoomsLoopAndTakesOutTheDrift) {
-  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+/// The room's loop closer for odometry that drifts by DriftingOdometry's exaggerated rates (14 deg
+/// a minute), so that each correction is plain to see. The odometry edges' model (0.001 rad/m)
+/// rules such a drift out, and the plausibility test would refuse its loops: it is off here and
+/// tested on its own (RefusesALookAlikePlace...).
+LoopClosureConfig room_config_for_exaggerated_drift() {
   LoopClosureConfig config;
   config.min_separation_s = 15.0;
+  config.loop_max_correction_sigmas = 0.0;
+  return config;
+}
+
+TEST(LoopCloser, ClosesTheRoomsLoopAndTakesOutTheDrift) {
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  LoopClosureConfig config = room_config_for_exaggerated_drift();
   LoopCloser closer(config);
   const DriftingOdometry odometry{.yaw_radps = 0.004, .drift_mps = 0.02};
   const Replayed r = replay(run, odometry, closer);
@@ -137,8 +147,7 @@ TEST(LoopCloser, PutsTheCorrectionWhereTheOdometryWasDegenerate) {
 
 TEST(LoopCloser, FindsLoopsByDescriptorAloneWhenTheEstimateIsNoGuide) {
   const sim::LidarImuRun& run = test::simulated("room", 60.0);
-  LoopClosureConfig config;
-  config.min_separation_s = 15.0;
+  LoopClosureConfig config = room_config_for_exaggerated_drift();
   // No candidate is ever near enough the estimate: only Scan Context can find the revisits, and
   // each of its loops must be confirmed by the next attempt before it is accepted.
   config.search_radius_m = 0.0;
@@ -160,8 +169,7 @@ TEST(LoopCloser, KeyframesInAMappedPlaceKeepNoCloudAndTheLoopsStillHold) {
   // cloud drops its own, so laps after the first add poses, not points.
   const sim::LidarImuRun& run = test::simulated("room", 60.0);
   const DriftingOdometry odometry{.yaw_radps = 0.004, .drift_mps = 0.02};
-  LoopClosureConfig config;
-  config.min_separation_s = 15.0;
+  LoopClosureConfig config = room_config_for_exaggerated_drift();
   LoopClosureConfig keep_all = config;
   keep_all.mapped_keyframe_distance_m = 0.0;
   LoopCloser pruned(config);
@@ -228,6 +236,61 @@ TEST(LoopCloser, NoKeyframeDropsItsCloudBeforeALoopVouchesForTheMap) {
   for (std::size_t i = 0; i < closer.keyframe_count(); ++i) {
     EXPECT_GT(closer.keyframe_points(i).size(), 0u) << "keyframe " << i;
   }
+}
+
+/// Two laps of the room, then the same scans again in a twin room 60 m away and turned by 40
+/// deg (the drive between them is one odometry edge): every keyframe of the twin matches one of
+/// the first room by descriptor and registers onto it as well as onto its own, and only the
+/// odometry says the places differ. Returns the loops from the twin onto the first room.
+std::size_t loops_into_a_twin_room(LoopCloser& closer) {
+  const sim::LidarImuRun& run = test::simulated("room", 60.0);
+  const Eigen::Isometry3d T_twin = test::pose(60, 0, 0, 40.0 * M_PI / 180.0);
+  const std::int64_t pass_ns = run.scans.back().end.ns - run.scans.front().end.ns + 1'000'000'000;
+  const HostTime twin_from{run.scans.front().end.ns + pass_ns};
+  std::vector<Eigen::Vector3f> points_base;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const sim::DecodedScan& scan : run.scans) {
+      test::deskewed_base(run, scan, points_base);
+      const Eigen::Isometry3d T_odom_base =
+          pass == 0 ? run.T_map_base(scan.end) : T_twin * run.T_map_base(scan.end);
+      closer.add(HostTime{scan.end.ns + pass * pass_ns}, T_odom_base, points_base);
+    }
+  }
+  std::size_t across = 0;
+  for (const LoopRecord& loop : closer.loops()) {
+    across += closer.keyframe_stamp(loop.query) >= twin_from &&
+              closer.keyframe_stamp(loop.candidate) < twin_from;
+  }
+  return across;
+}
+
+TEST(LoopCloser, RefusesALookAlikePlaceWhoseCorrectionTheOdometryCannotHaveDrifted) {
+  LoopClosureConfig config;
+  config.min_separation_s = 15.0;
+  // Without the test the twin's descriptor matches are confirmed and accepted: the scene does
+  // fool the registration.
+  config.loop_max_correction_sigmas = 0.0;
+  LoopCloser fooled(config);
+  ASSERT_GT(loops_into_a_twin_room(fooled), 0u);
+  ASSERT_GT(fooled.T_map_odom().translation().norm(), 30.0);
+
+  config.loop_max_correction_sigmas = LoopClosureConfig{}.loop_max_correction_sigmas;
+  LoopCloser closer(config);
+  EXPECT_EQ(loops_into_a_twin_room(closer), 0u);
+  const LoopClosureFigures& f = closer.figures();
+  EXPECT_GT(f.implausible, 0u);
+  ASSERT_TRUE(closer.last_implausible().has_value());
+  EXPECT_GT(closer.last_implausible()->correction_m, 30.0);
+  std::printf(
+      "fooled: %zu loops, map -> odom %.1f m; tested: %llu loops, %llu implausible (last "
+      "%.1f m, %.1f sigma)\n",
+      fooled.loops().size(), fooled.T_map_odom().translation().norm(),
+      static_cast<unsigned long long>(f.loops), static_cast<unsigned long long>(f.implausible),
+      closer.last_implausible()->correction_m, closer.last_implausible()->correction_sigmas);
+  // Each room's own revisits still close, each well within the odometry's reach.
+  ASSERT_GT(f.loops, 1u);
+  for (const LoopRecord& loop : closer.loops()) EXPECT_LT(loop.correction_sigmas, 3.0);
+  EXPECT_LT(closer.T_map_odom().translation().norm(), 0.5);
 }
 
 TEST(LoopCloser, WithoutLoopsTheCorrectionStaysIdentity) {
