@@ -227,6 +227,12 @@ bool print_run_summary(const RunSummary& r) {
     std::printf("  IMU biases          gyro [%.5f %.5f %.5f] rad/s, accel [%.4f %.4f %.4f] m/s^2\n",
                 f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
                 f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());
+    if (f.gravity_tilt_estimated) {
+      std::printf(
+          "  map tilt            %.3f deg about x, %.3f deg about y (gravity's direction in "
+          "the map, estimated)\n",
+          f.gravity_tilt_rad.x() * 180.0 / M_PI, f.gravity_tilt_rad.y() * 180.0 / M_PI);
+    }
   }
   if (!st.estimator.camera.mode.empty()) {
     const CameraFigures& c = st.estimator.camera;

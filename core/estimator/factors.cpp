@@ -24,8 +24,23 @@ void pose_jacobian(const Eigen::Matrix<double, M, 6>& J_tangent, const double* p
 
 }  // namespace
 
-ImuFactor::ImuFactor(const imu::Preintegration& pre, double gravity_mps2)
-    : pre_(pre), g_(0, 0, -gravity_mps2) {
+Eigen::Vector3d tilted_gravity(double gravity_mps2, const double* tilt,
+                               Eigen::Matrix<double, 3, 2>* d_dtilt) {
+  const Eigen::Vector3d phi(tilt[0], tilt[1], 0.0);
+  const Eigen::Vector3d g0(0, 0, -gravity_mps2);
+  const Mat3 R = so3::exp(phi);
+  if (d_dtilt != nullptr) {
+    // d(Exp(phi) g0)/dphi = -Exp(phi) [g0]x Jr(phi); only phi's x and y are free.
+    *d_dtilt = (-R * skew(g0) * so3::right_jacobian(phi)).leftCols<2>();
+  }
+  return R * g0;
+}
+
+ImuFactor::ImuFactor(const imu::Preintegration& pre, double gravity_mps2, bool with_gravity_tilt)
+    : pre_(pre), g_(0, 0, -gravity_mps2), with_gravity_tilt_(with_gravity_tilt) {
+  set_num_residuals(15);
+  *mutable_parameter_block_sizes() = {7, 9, 7, 9};
+  if (with_gravity_tilt_) mutable_parameter_block_sizes()->push_back(2);
   Eigen::Matrix<double, 15, 15> cov = Eigen::Matrix<double, 15, 15>::Zero();
   cov.topLeftCorner<9, 9>() = pre.covariance();
   cov.block<3, 3>(9, 9).diagonal().setConstant(pre.gyro_bias_walk_variance());
@@ -49,11 +64,14 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
   const Eigen::Vector3d dbg = bgi - lin.gyro_radps;
   const double dt = pre_.dt_s();
 
+  Eigen::Matrix<double, 3, 2> dg_dtilt = Eigen::Matrix<double, 3, 2>::Zero();
+  const Eigen::Vector3d g =
+      with_gravity_tilt_ ? tilted_gravity(-g_.z(), parameters[4], &dg_dtilt) : g_;
   const Mat3 Rc = pre_.corrected_delta_R(bgi);
   const Mat3 E = Rc.transpose() * Ri_T * Rj;
   const Eigen::Vector3d r_R = so3::log(E);
-  const Eigen::Vector3d dv_world = vj - vi - g_ * dt;
-  const Eigen::Vector3d dp_world = pj - pi - vi * dt - 0.5 * g_ * dt * dt;
+  const Eigen::Vector3d dv_world = vj - vi - g * dt;
+  const Eigen::Vector3d dp_world = pj - pi - vi * dt - 0.5 * g * dt * dt;
   Eigen::Matrix<double, 15, 1> r;
   r.segment<3>(0) = r_R;
   r.segment<3>(3) = Ri_T * dv_world - pre_.corrected_delta_v(bgi, bai);
@@ -100,6 +118,13 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
     J.block<3, 3>(9, 3) = Mat3::Identity();
     J.block<3, 3>(12, 6) = Mat3::Identity();
     Eigen::Map<Eigen::Matrix<double, 15, 9, Eigen::RowMajor>> Jm(jacobians[3]);
+    Jm = sqrt_info_ * J;
+  }
+  if (with_gravity_tilt_ && jacobians[4] != nullptr) {  // gravity tilt [a, b]
+    Eigen::Matrix<double, 15, 2> J = Eigen::Matrix<double, 15, 2>::Zero();
+    J.block<3, 2>(3, 0) = -Ri_T * dg_dtilt * dt;
+    J.block<3, 2>(6, 0) = -0.5 * Ri_T * dg_dtilt * dt * dt;
+    Eigen::Map<Eigen::Matrix<double, 15, 2, Eigen::RowMajor>> Jm(jacobians[4]);
     Jm = sqrt_info_ * J;
   }
   return true;

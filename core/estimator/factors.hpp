@@ -19,18 +19,28 @@ namespace posed::estimator {
 
 /// Preintegrated IMU between states i and j (Forster eq. 45) and the bias random walk:
 /// 15 residuals [rotation, velocity, position, gyro bias change, accel bias change].
-class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
+/// With `with_gravity_tilt`, a fifth block [a, b] (2) [rad] tilts gravity in the map frame:
+/// g_map = Exp([a, b, 0]) (0, 0, -g). The map frame is the first scan's, levelled only as well as
+/// the start-up alignment could; estimated, its tilt's share of gravity no longer has to hide in
+/// the accelerometer bias (docs/estimator.md, Known limits).
+class ImuFactor final : public ceres::CostFunction {
  public:
   /// Weighed by the preintegration's covariance and its biases' random walk.
-  ImuFactor(const imu::Preintegration& pre, double gravity_mps2);
+  ImuFactor(const imu::Preintegration& pre, double gravity_mps2, bool with_gravity_tilt = false);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
   imu::Preintegration pre_;
   Eigen::Vector3d g_;
+  bool with_gravity_tilt_;
   Eigen::Matrix<double, 15, 15> sqrt_info_;
 };
+
+/// Gravity in the map frame for a tilt [a, b] of it (ImuFactor's fifth block) [m/s²], and its
+/// Jacobian with respect to [a, b] when `d_dtilt` is given.
+Eigen::Vector3d tilted_gravity(double gravity_mps2, const double* tilt,
+                               Eigen::Matrix<double, 3, 2>* d_dtilt = nullptr);
 
 /// A scan-to-map pose of the lidar, with its information (rotation, translation; right
 /// perturbation), on the IMU pose through T_imu_lidar: 6 residuals [rotation, translation].

@@ -136,6 +136,10 @@ struct FusionFigures {
   int degenerate_directions = 0;                              ///< in the last scan's match [1]
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  ///< current estimate [rad/s]
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]
+  /// the map frame's tilt about its x and y as the window estimates it (zero unless
+  /// estimator.estimate_gravity_tilt) [rad]
+  Eigen::Vector2d gravity_tilt_rad = Eigen::Vector2d::Zero();
+  bool gravity_tilt_estimated = false;
   /// the camera front end's figures (mode empty without one)
   CameraFigures camera;
   /// the camera streams in the back end (visible, thermal, fused)

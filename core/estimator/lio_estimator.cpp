@@ -47,9 +47,11 @@ LioEstimator::LioEstimator(const LioConfig& config)
 FusionFigures LioEstimator::figures() const {
   FusionFigures f = figures_;
   f.keyframes = lidar_.counters().keyframes;
+  f.gravity_tilt_estimated = config_.window.estimate_gravity_tilt;
   if (anchor_) {
     f.gyro_bias_radps = anchor_->bias.gyro_radps;
     f.accel_bias_mps2 = anchor_->bias.accel_mps2;
+    f.gravity_tilt_rad = window_.gravity_tilt();
   } else if (aligned_) {
     f.gyro_bias_radps = aligned_->gyro_bias_radps;
   }
@@ -80,6 +82,7 @@ NavState LioEstimator::to_nav_state(const imu::ImuState& s, const Eigen::Vector3
   out.anchor = optimised;
   out.gyro_bias_radps = s.bias.gyro_radps;
   out.accel_bias_mps2 = s.bias.accel_mps2;
+  if (config_.window.estimate_gravity_tilt) out.gravity_map_mps2 = window_.gravity_map();
   out.sequence = 0;
   return out;
 }
@@ -118,7 +121,7 @@ void LioEstimator::add_imu(const ImuSample& sample, std::vector<NavState>& state
     step.add(*propagated_last_);
     step.add(sample);
     const HostTime stamp = sample.stamp;
-    propagated_ = step.predict(propagated_, config_.gravity_mps2);
+    propagated_ = step.predict(propagated_, window_.gravity_map());
     propagated_.stamp = stamp;
     propagated_last_ = sample;
     // Uncertainty grows from the anchor's with the IMU's white noise (random-walk model).
@@ -168,7 +171,7 @@ LioEstimator::Integrated LioEstimator::integrate(const imu::ImuState& from, Host
   std::vector<std::pair<HostTime, Eigen::Isometry3d>> lidar_poses;
   const auto record = [&] {
     if (motion == nullptr) return;
-    const imu::ImuState s = out.pre.predict(from, config_.gravity_mps2);
+    const imu::ImuState s = out.pre.predict(from, window_.gravity_map());
     lidar_poses.emplace_back(out.pre.end(), imu::T_map_imu(s) * config_.T_imu_lidar);
   };
   // Start exactly at `from`: interpolate between the bracket below it and the next sample.
@@ -223,7 +226,7 @@ void LioEstimator::reanchor_propagation(const imu::ImuState& state) {
     imu::Preintegration step(imu::ImuNoise{}, propagated_.bias, previous->stamp);
     step.add(*previous);
     step.add(s);
-    propagated_ = step.predict(propagated_, config_.gravity_mps2);
+    propagated_ = step.predict(propagated_, window_.gravity_map());
     propagated_.stamp = s.stamp;
     previous = s;
   }
@@ -325,7 +328,7 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     ++figures_.scans_skipped;
     return;
   }
-  imu::ImuState predicted = integrated.pre.predict(from, config_.gravity_mps2);
+  imu::ImuState predicted = integrated.pre.predict(from, window_.gravity_map());
   predicted.stamp = t;
   const Eigen::Isometry3d T_pred = imu::T_map_imu(predicted) * config_.T_imu_lidar;
 

@@ -58,6 +58,9 @@ struct NavState {
   /// the biases the state was estimated with [rad/s], [m/s^2]
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
+  /// gravity in map as the state was estimated with, when the estimator estimates the map's
+  /// tilt; zero: (0, 0, -g) [m/s^2]
+  Eigen::Vector3d gravity_map_mps2 = Eigen::Vector3d::Zero();
   /// host receive time of the newest sample that went into the state (the Source's receive
   /// stamp; set by the pipeline, unset by the cores), for latency figures
   HostTime received;

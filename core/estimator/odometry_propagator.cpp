@@ -16,7 +16,8 @@ imu::ImuState OdometryPropagator::step(const imu::ImuState& state, const ImuSamp
   imu::Preintegration pre(imu::ImuNoise{}, state.bias, from.stamp);
   pre.add(from);
   pre.add(to);
-  imu::ImuState next = pre.predict(state, config_.gravity_mps2);
+  imu::ImuState next = gravity_map_mps2_.isZero() ? pre.predict(state, config_.gravity_mps2)
+                                                  : pre.predict(state, gravity_map_mps2_);
   next.stamp = to.stamp;
   return next;
 }
@@ -31,6 +32,7 @@ void OdometryPropagator::set_anchor(const NavState& anchor) {
   propagated_.v_map_mps = anchor.v_map_mps;
   propagated_.bias.gyro_radps = anchor.gyro_bias_radps;
   propagated_.bias.accel_mps2 = anchor.accel_bias_mps2;
+  gravity_map_mps2_ = anchor.gravity_map_mps2;
   last_.reset();
   // Integrate again through the samples since the anchor: they were published from the old one.
   if (!history_.empty()) {

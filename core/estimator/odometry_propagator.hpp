@@ -70,6 +70,8 @@ class OdometryPropagator {
   ImuBuffer history_;
   std::vector<ImuSample> scratch_;
   std::optional<NavState> anchor_;
+  /// the anchor's gravity in map (NavState::gravity_map_mps2; zero: the config's)
+  Eigen::Vector3d gravity_map_mps2_ = Eigen::Vector3d::Zero();
   /// the anchor carried forward through every sample since (without the blend)
   imu::ImuState propagated_;
   std::optional<ImuSample> last_;

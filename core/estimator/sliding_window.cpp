@@ -72,7 +72,15 @@ std::optional<std::size_t> SlidingWindow::index_of(std::uint64_t id) const {
   return i;
 }
 
+Eigen::Vector3d SlidingWindow::gravity_map() const {
+  return config_.estimate_gravity_tilt ? tilted_gravity(config_.gravity_mps2, gravity_tilt_)
+                                       : Eigen::Vector3d(0, 0, -config_.gravity_mps2);
+}
+
 double* SlidingWindow::block(const BlockRef& ref) {
+  if (ref.role == BlockRole::kGravityTilt) {
+    return config_.estimate_gravity_tilt ? gravity_tilt_ : nullptr;
+  }
   const std::optional<std::size_t> i = index_of(ref.state_id);
   if (!i) return nullptr;
   State& s = states_[*i];
@@ -93,6 +101,14 @@ void SlidingWindow::reset(const imu::ImuState& state,
   add_factor(FactorKind::kPrior,
              std::make_unique<MarginalPrior>(std::move(blocks), J, Eigen::VectorXd::Zero(15)),
              {{s.id, BlockRole::kPose}, {s.id, BlockRole::kSpeedBias}});
+  if (config_.estimate_gravity_tilt) {
+    // The tilt found so far (the map stays), held as well as the start-up alignment levels.
+    std::vector<PriorBlock> tilt = {{2, std::vector<double>(gravity_tilt_, gravity_tilt_ + 2)}};
+    const Eigen::MatrixXd J_tilt = Eigen::MatrixXd::Identity(2, 2) / config_.gravity_tilt_prior_rad;
+    add_factor(FactorKind::kPrior,
+               std::make_unique<MarginalPrior>(std::move(tilt), J_tilt, Eigen::VectorXd::Zero(2)),
+               {{0, BlockRole::kGravityTilt}});
+  }
 }
 
 void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& pre,
@@ -110,12 +126,15 @@ void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& p
                {{s.id, BlockRole::kPose}});
   }
   if (previous) {
-    add_factor(FactorKind::kImu,
-               std::make_unique<ImuFactor>(pre, config_.gravity_mps2),
-               {{*previous, BlockRole::kPose},
-                {*previous, BlockRole::kSpeedBias},
-                {s.id, BlockRole::kPose},
-                {s.id, BlockRole::kSpeedBias}});
+    std::vector<BlockRef> refs = {{*previous, BlockRole::kPose},
+                                  {*previous, BlockRole::kSpeedBias},
+                                  {s.id, BlockRole::kPose},
+                                  {s.id, BlockRole::kSpeedBias}};
+    if (config_.estimate_gravity_tilt) refs.push_back({0, BlockRole::kGravityTilt});
+    add_factor(
+        FactorKind::kImu,
+        std::make_unique<ImuFactor>(pre, config_.gravity_mps2, config_.estimate_gravity_tilt),
+        refs);
   }
   while (static_cast<int>(states_.size()) > config_.size) marginalise_oldest();
 }
@@ -128,7 +147,9 @@ bool SlidingWindow::add_factor(FactorKind kind, std::unique_ptr<ceres::CostFunct
   f.kind = kind;
   for (std::size_t k = 0; k < refs.size(); ++k) {
     double* b = block(refs[k]);
-    const int expected = refs[k].role == BlockRole::kPose ? 7 : 9;
+    const int expected = refs[k].role == BlockRole::kPose        ? 7
+                         : refs[k].role == BlockRole::kSpeedBias ? 9
+                                                                 : 2;
     if (b == nullptr || cost->parameter_block_sizes()[k] != expected) return false;
     f.blocks.push_back(b);
   }
@@ -151,6 +172,7 @@ bool SlidingWindow::solve() {
     problem.AddParameterBlock(s.pose, 7, &pose_manifold());
     problem.AddParameterBlock(s.speed_bias, 9);
   }
+  if (config_.estimate_gravity_tilt) problem.AddParameterBlock(gravity_tilt_, 2);
   for (WindowFactor& f : factors_) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -231,6 +253,7 @@ Eigen::Matrix<double, 6, 6> SlidingWindow::latest_pose_covariance() const {
     layout.add(s.pose, 7);
     layout.add(s.speed_bias, 9);
   }
+  if (config_.estimate_gravity_tilt) layout.add(gravity_tilt_, 2);
   const int n = layout.size;
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
   for (const WindowFactor& f : factors_) accumulate(f, layout, H, nullptr);

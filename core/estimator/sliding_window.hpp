@@ -31,6 +31,11 @@ struct SlidingWindowConfig {
   int max_iterations = 8;  ///< Levenberg-Marquardt iterations per solve [1]
   double gravity_mps2 = 9.805;
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
+  /// Estimate the map frame's tilt (gravity's direction in map) as a block of the window, shared
+  /// by every IMU factor and kept through marginalisation (docs/estimator.md, Known limits)
+  bool estimate_gravity_tilt = false;
+  /// its prior at a reset, 1 sigma per axis [rad]
+  double gravity_tilt_prior_rad = 0.02;
 };
 
 /// A lidar pose measurement for one state.
@@ -89,6 +94,11 @@ class SlidingWindow {
   /// Whitened residual norm |r| of every factor of `kind` at the current estimate, in list order.
   void residual_norms(FactorKind kind, std::vector<double>& out) const;
   const SlidingWindowCounters& counters() const { return counters_; }
+  /// Gravity in the map frame as the window estimates it [m/s²]: (0, 0, -g) unless it
+  /// estimates the map's tilt.
+  Eigen::Vector3d gravity_map() const;
+  /// The estimated tilt of the map frame about its x and y [rad] (zero unless estimated).
+  Eigen::Vector2d gravity_tilt() const { return {gravity_tilt_[0], gravity_tilt_[1]}; }
 
  private:
   struct State {
@@ -105,6 +115,8 @@ class SlidingWindow {
   std::vector<WindowFactor> factors_;
   std::uint64_t next_id_ = 1;
   SlidingWindowCounters counters_;
+  // The map frame's tilt (kGravityTilt); kept through resets: the map it belongs to stays.
+  double gravity_tilt_[2] = {0.0, 0.0};
 };
 
 }  // namespace posed::estimator

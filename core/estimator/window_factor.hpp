@@ -39,6 +39,9 @@ constexpr std::string_view to_string(FactorKind k) {
 enum class BlockRole : std::uint8_t {
   kPose,       ///< [p_map_imu (3) [m], q_map_imu (4, x y z w)], tangent [dp (map), dtheta (body)]
   kSpeedBias,  ///< [v_map (3) [m/s], b_g (3) [rad/s], b_a (3) [m/s²]]
+  /// the map frame's tilt [a, b] (2) [rad], one block for the whole window (state_id unused);
+  /// only when the window estimates it (SlidingWindowConfig::estimate_gravity_tilt)
+  kGravityTilt,
 };
 
 /// A block by its owner: the state with this id.

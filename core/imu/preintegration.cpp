@@ -129,7 +129,10 @@ Eigen::Vector3d Preintegration::corrected_delta_p(const Eigen::Vector3d& bg,
 }
 
 ImuState Preintegration::predict(const ImuState& s, double gravity_mps2) const {
-  const Eigen::Vector3d g(0, 0, -gravity_mps2);
+  return predict(s, Eigen::Vector3d(0, 0, -gravity_mps2));
+}
+
+ImuState Preintegration::predict(const ImuState& s, const Eigen::Vector3d& g) const {
   const Eigen::Matrix3d Ri = s.q_map_imu.toRotationMatrix();
   const Eigen::Vector3d& bg = s.bias.gyro_radps;
   const Eigen::Vector3d& ba = s.bias.accel_mps2;

@@ -102,6 +102,8 @@ class Preintegration {
   /// The state at end() from `start` (stamp ignored) under gravity g_map = (0, 0, -g) [m/s²],
   /// with the biases of `start` (first-order correction); biases carry over unchanged.
   ImuState predict(const ImuState& start, double gravity_mps2) const;
+  /// The same under any gravity vector in map (the map frame's own tilt estimated) [m/s²].
+  ImuState predict(const ImuState& start, const Eigen::Vector3d& g_map_mps2) const;
 
   /// The 9-vector residual [rotation, velocity, position] of states i and j against this
   /// preintegration (Forster eq. 45), unweighted.

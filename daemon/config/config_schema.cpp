@@ -352,6 +352,12 @@ const Field kSchema[] = {
       "largest rate still counted as standing still during alignment"),
     F("estimator.window_size", estimator.window_size, "10", "", 2, 50, "",
       "states in the lidar-inertial fixed-lag window"),
+    F("estimator.estimate_gravity_tilt", estimator.estimate_gravity_tilt, "false", "", 0, 0, "",
+      "estimate the map frame's tilt (gravity's direction in map) in the window: the map is "
+      "levelled only as well as the start-up alignment could, and what it misses otherwise "
+      "hides in the accelerometer bias, wrong after every turn"),
+    F("estimator.gravity_tilt_prior_deg", estimator.gravity_tilt_prior_deg, "1", "deg", 0.01, 10,
+      "", "the tilt's prior at a (re)start, 1 sigma per axis"),
     F("estimator.solver_iterations", estimator.solver_iterations, "8", "", 1, 100, "",
       "Levenberg-Marquardt iterations of the window per scan"),
     F("estimator.max_speed_mps", estimator.max_speed_mps, "40", "m/s", 1, 200, "",

@@ -52,6 +52,8 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.lidar.keyframe_angle_rad = e.keyframe_angle_deg * kDeg;
   l.window.size = e.window_size;
   l.window.max_iterations = e.solver_iterations;
+  l.window.estimate_gravity_tilt = e.estimate_gravity_tilt;
+  l.window.gravity_tilt_prior_rad = e.gravity_tilt_prior_deg * kDeg;
   l.max_speed_mps = e.max_speed_mps;
   l.max_gyro_bias_radps = e.max_gyro_bias_radps;
   l.max_accel_bias_mps2 = e.max_accel_bias_mps2;

@@ -86,6 +86,51 @@ TEST(Factors, ImuFactorJacobiansMatchNumericDifferentiation) {
   expect_jacobians_match(results, 1e-5);
 }
 
+TEST(Factors, ImuFactorWithTheMapsTiltJacobiansMatchNumericDifferentiation) {
+  // The same factor with gravity's direction in the map as a fifth block, at a tilt of about a
+  // degree (what a moving start-up alignment leaves).
+  const test::AnalyticMotion m;
+  imu::ImuBias lin;
+  lin.gyro_radps = {0.01, -0.02, 0.005};
+  lin.accel_mps2 = {0.05, 0.02, -0.04};
+  imu::Preintegration pre({2e-3, 3e-2, 1e-5, 1e-3}, lin, HostTime::from_ns(0));
+  for (int k = 0; k <= 40; ++k) pre.add(m.sample(1.0 + k / 200.0));
+  const ImuFactor factor(pre, m.gravity_mps2, true);
+  ASSERT_EQ(factor.parameter_block_sizes().size(), 5u);
+
+  imu::ImuState i = m.state(1.0), j = m.state(1.2);
+  i.p_map_imu_m += Eigen::Vector3d(0.1, -0.05, 0.02);
+  j.v_map_mps += Eigen::Vector3d(0.05, 0.1, -0.02);
+  i.bias.accel_mps2 = {0.06, 0.01, -0.03};
+  j.bias = i.bias;
+  double pose_i[7], sb_i[9], pose_j[7], sb_j[9];
+  state_arrays(i, pose_i, sb_i);
+  state_arrays(j, pose_j, sb_j);
+  double tilt[2] = {0.012, -0.02};
+  const double* params[] = {pose_i, sb_i, pose_j, sb_j, tilt};
+  PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, &pose_manifold,
+                                                         nullptr, nullptr};
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, 1e-5, &results);
+  expect_jacobians_match(results, 1e-5);
+
+  // At zero tilt it is the plain factor.
+  const ImuFactor plain(pre, m.gravity_mps2);
+  double zero[2] = {0, 0};
+  const double* tilted_params[] = {pose_i, sb_i, pose_j, sb_j, zero};
+  Eigen::Matrix<double, 15, 1> r_tilted, r_plain;
+  ASSERT_TRUE(factor.Evaluate(tilted_params, r_tilted.data(), nullptr));
+  ASSERT_TRUE(plain.Evaluate(params, r_plain.data(), nullptr));
+  EXPECT_LT((r_tilted - r_plain).norm(), 1e-9 * std::max(1.0, r_plain.norm()));
+  // And the tilt turns gravity: 0.02 rad about y moves it by g sin(0.02) along -x.
+  const Eigen::Vector3d g = tilted_gravity(9.8, tilt);
+  EXPECT_NEAR(g.norm(), 9.8, 1e-9);
+  EXPECT_NEAR(g.x(), -9.8 * std::sin(-0.02) * std::cos(0.012), 2e-3);
+}
+
 TEST(Factors, LidarPoseFactorJacobiansMatchNumericDifferentiation) {
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
   T_imu_lidar.linear() = so3::exp(Eigen::Vector3d(0.01, 0.02, -0.5));
