@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/math/se3.hpp"
 #include "core/math/so3.hpp"
 #include "core/sync/pose_interpolation.hpp"
 
@@ -25,17 +26,6 @@ Eigen::Isometry3d isometry(const Pose& p) {
   T.linear() = p.q.normalized().toRotationMatrix();
   T.translation() = p.p;
   return T;
-}
-
-/// Adjoint of T for the (rotation, translation) right perturbation T Exp(ξ) = (R Exp(φ), p + R ρ):
-/// T Exp(ξ) T⁻¹ = Exp(Ad(T) ξ).
-Mat6 adjoint(const Eigen::Isometry3d& T) {
-  Mat6 A = Mat6::Zero();
-  const Eigen::Matrix3d R = T.linear();
-  A.topLeftCorner<3, 3>() = R;
-  A.bottomLeftCorner<3, 3>() = so3::skew(T.translation()) * R;
-  A.bottomRightCorner<3, 3>() = R;
-  return A;
 }
 
 const vision::ImageQuality& quality_of(const vision::FrontendFrame& f, std::size_t stream) {
@@ -170,7 +160,7 @@ std::optional<estimator::RelativeMotion> CameraFactors::measure(
   motion.from_index = k;
   motion.T_k_j = imu::T_map_imu(at_k).inverse() * T_map_a * measured_a_b * bridge_b_j;
   motion.T_i_j = imu::T_map_imu(i).inverse() * imu::T_map_imu(at_k) * motion.T_k_j;
-  const Mat6 A = adjoint(bridge_b_j.inverse()) * adjoint(T_imu_s);
+  const Mat6 A = se3::adjoint(bridge_b_j.inverse()) * se3::adjoint(T_imu_s);
   const double omega = std::max(a->omega, b->omega) * residual_scale_[stream];
   Mat6 covariance = omega * A * m.covariance * A.transpose();
   const double floor_m = !lidar_weak_ && lidar_settled_ ? config_.strong_lidar_floor_translation_m

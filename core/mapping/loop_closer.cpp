@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/mapping/place_recognition.hpp"
+#include "core/math/se3.hpp"
 
 namespace posed::mapping {
 namespace {
@@ -17,21 +18,6 @@ double seconds_between(HostTime a, HostTime b) { return static_cast<double>(b.ns
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
-/// Adjoint of T for perturbations [translation, rotation]: T exp(xi) T^-1 = exp(Ad(T) xi).
-Matrix6d adjoint(const Eigen::Isometry3d& T) {
-  Matrix6d ad = Matrix6d::Zero();
-  ad.topLeftCorner<3, 3>() = T.rotation();
-  ad.topRightCorner<3, 3>() = skew(T.translation()) * T.rotation();
-  ad.bottomRightCorner<3, 3>() = T.rotation();
-  return ad;
-}
 
 }  // namespace
 
@@ -282,29 +268,29 @@ void LoopCloser::try_loop(std::size_t query) {
 
 double LoopCloser::correction_sigmas(std::size_t candidate, std::size_t query,
                                      const Eigen::Isometry3d& T_candidate_query) const {
-  // The covariance of a right perturbation of T_candidate_i, carried along the odometry edges:
-  // each moves the perturbation so far into its own end's frame and adds its own.
+  // The covariance of a right perturbation [rotation, translation] of T_candidate_i, carried
+  // along the odometry edges: each moves the perturbation so far into its own end's frame and
+  // adds its own.
   Matrix6d covariance = Matrix6d::Zero();
   for (std::size_t i = candidate + 1; i <= query; ++i) {
     const Keyframe& kf = keyframes_[i];
     const Eigen::Isometry3d T_i_previous = kf.T_odom_base.inverse() * keyframes_[i - 1].T_odom_base;
-    const Matrix6d ad = adjoint(T_i_previous);
+    const Matrix6d ad = se3::adjoint(T_i_previous);
     covariance = ad * covariance * ad.transpose();
     covariance.diagonal().head<3>().array() +=
-        kf.edge_sigma_translation_m * kf.edge_sigma_translation_m;
-    covariance.diagonal().tail<3>().array() +=
         kf.edge_sigma_rotation_rad * kf.edge_sigma_rotation_rad;
+    covariance.diagonal().tail<3>().array() +=
+        kf.edge_sigma_translation_m * kf.edge_sigma_translation_m;
   }
   covariance.diagonal().head<3>().array() +=
-      config_.loop_sigma_translation_m * config_.loop_sigma_translation_m;
-  covariance.diagonal().tail<3>().array() +=
       config_.loop_sigma_rotation_rad * config_.loop_sigma_rotation_rad;
+  covariance.diagonal().tail<3>().array() +=
+      config_.loop_sigma_translation_m * config_.loop_sigma_translation_m;
   const Eigen::Isometry3d T_graph = graph_.node(candidate).inverse() * graph_.node(query);
   const Eigen::Isometry3d delta = T_graph.inverse() * T_candidate_query;
-  const Eigen::AngleAxisd rotation(delta.rotation());
   Vector6d error;
-  error.head<3>() = delta.translation();
-  error.tail<3>() = rotation.angle() * rotation.axis();
+  error.head<3>() = so3::log(Eigen::Matrix3d(delta.rotation()));
+  error.tail<3>() = delta.translation();
   return std::sqrt(std::max(0.0, error.dot(covariance.ldlt().solve(error))));
 }
 

@@ -54,13 +54,19 @@ void expect_jacobians_match(const ceres::GradientChecker::ProbeResults& r, doubl
   }
 }
 
-TEST(Factors, ImuFactorJacobiansMatchNumericDifferentiation) {
-  const test::AnalyticMotion m;
+/// The motion's IMU samples from 1.0 to 1.2 s, preintegrated about biases away from zero.
+imu::Preintegration preintegrated_from_1_to_1_2_s(const test::AnalyticMotion& m) {
   imu::ImuBias lin;
   lin.gyro_radps = {0.01, -0.02, 0.005};
   lin.accel_mps2 = {0.05, 0.02, -0.04};
   imu::Preintegration pre({2e-3, 3e-2, 1e-5, 1e-3}, lin, HostTime::from_ns(0));
   for (int k = 0; k <= 40; ++k) pre.add(m.sample(1.0 + k / 200.0));
+  return pre;
+}
+
+TEST(Factors, ImuFactorJacobiansMatchNumericDifferentiation) {
+  const test::AnalyticMotion m;
+  const imu::Preintegration pre = preintegrated_from_1_to_1_2_s(m);
   const ImuFactor factor(pre, m.gravity_mps2);
 
   imu::ImuState i = m.state(1.0), j = m.state(1.2);
@@ -90,11 +96,7 @@ TEST(Factors, ImuFactorWithTheMapsTiltJacobiansMatchNumericDifferentiation) {
   // The same factor with gravity's direction in the map as a fifth block, at a tilt of about a
   // degree (what a moving start-up alignment leaves).
   const test::AnalyticMotion m;
-  imu::ImuBias lin;
-  lin.gyro_radps = {0.01, -0.02, 0.005};
-  lin.accel_mps2 = {0.05, 0.02, -0.04};
-  imu::Preintegration pre({2e-3, 3e-2, 1e-5, 1e-3}, lin, HostTime::from_ns(0));
-  for (int k = 0; k <= 40; ++k) pre.add(m.sample(1.0 + k / 200.0));
+  const imu::Preintegration pre = preintegrated_from_1_to_1_2_s(m);
   const ImuFactor factor(pre, m.gravity_mps2, true);
   ASSERT_EQ(factor.parameter_block_sizes().size(), 5u);
 
