@@ -230,8 +230,12 @@ bool print_run_summary(const RunSummary& r) {
     if (f.gravity_tilt_estimated) {
       std::printf(
           "  map tilt            %.3f deg about x, %.3f deg about y (gravity's direction in "
-          "the map, estimated)\n",
-          f.gravity_tilt_rad.x() * 180.0 / M_PI, f.gravity_tilt_rad.y() * 180.0 / M_PI);
+          "the map; headings spanned where the lidar pinned the position %.0f deg; free in "
+          "%.1f %% of the window's solves, held before)\n",
+          f.gravity_tilt_rad.x() * 180.0 / M_PI, f.gravity_tilt_rad.y() * 180.0 / M_PI,
+          f.heading_span_rad * 180.0 / M_PI,
+          100.0 * static_cast<double>(f.window_solves_tilt_free) /
+              static_cast<double>(std::max<std::uint64_t>(f.window_solves, 1)));
     }
   }
   if (!st.estimator.camera.mode.empty()) {

@@ -52,6 +52,10 @@ FusionFigures LioEstimator::figures() const {
     f.gyro_bias_radps = anchor_->bias.gyro_radps;
     f.accel_bias_mps2 = anchor_->bias.accel_mps2;
     f.gravity_tilt_rad = window_.gravity_tilt();
+    f.gravity_tilt_free = window_.gravity_tilt_free();
+    f.heading_span_rad = window_.heading_span_rad();
+    f.window_solves = window_.counters().solves;
+    f.window_solves_tilt_free = window_.counters().solves_tilt_free;
   } else if (aligned_) {
     f.gyro_bias_radps = aligned_->gyro_bias_radps;
   }
@@ -82,7 +86,7 @@ NavState LioEstimator::to_nav_state(const imu::ImuState& s, const Eigen::Vector3
   out.anchor = optimised;
   out.gyro_bias_radps = s.bias.gyro_radps;
   out.accel_bias_mps2 = s.bias.accel_mps2;
-  if (config_.window.estimate_gravity_tilt) out.gravity_map_mps2 = window_.gravity_map();
+  if (window_.gravity_tilt_free()) out.gravity_map_mps2 = window_.gravity_map();
   out.sequence = 0;
   return out;
 }
@@ -386,6 +390,9 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
       !lidar_suspect_ && (t - *strong_since_).seconds() >= config_.aided_settled_after_s;
 
   begin(LioStep::kWindow);
+  // The map's tilt and an accelerometer bias only come apart in a turn where the lidar pins the
+  // position: a turn along a corridor's axis or on an open stretch does not count.
+  window_.set_position_pinned(match.ok && match.degenerate_directions == 0);
   if (window_.empty()) {
     // The first scan defines the map at the aligned IMU pose. Position and yaw are the map's
     // definition; tilt, velocity and gyro bias are as certain as the alignment made them.

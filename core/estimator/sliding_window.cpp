@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 
 #include "core/estimator/factors.hpp"
 #include "core/estimator/linearisation.hpp"
@@ -73,13 +74,43 @@ std::optional<std::size_t> SlidingWindow::index_of(std::uint64_t id) const {
 }
 
 Eigen::Vector3d SlidingWindow::gravity_map() const {
-  return config_.estimate_gravity_tilt ? tilted_gravity(config_.gravity_mps2, gravity_tilt_)
-                                       : Eigen::Vector3d(0, 0, -config_.gravity_mps2);
+  return tilt_released_ ? tilted_gravity(config_.gravity_mps2, gravity_tilt_)
+                        : Eigen::Vector3d(0, 0, -config_.gravity_mps2);
+}
+
+void SlidingWindow::add_gravity_tilt_prior() {
+  // The tilt found so far (the map stays), held as well as the start-up alignment levels.
+  std::vector<PriorBlock> tilt = {{2, std::vector<double>(gravity_tilt_, gravity_tilt_ + 2)}};
+  const Eigen::MatrixXd J_tilt = Eigen::MatrixXd::Identity(2, 2) / config_.gravity_tilt_prior_rad;
+  add_factor(FactorKind::kPrior,
+             std::make_unique<MarginalPrior>(std::move(tilt), J_tilt, Eigen::VectorXd::Zero(2)),
+             {{0, BlockRole::kGravityTilt}});
+}
+
+void SlidingWindow::release_gravity_tilt_when_observable() {
+  if (!config_.estimate_gravity_tilt || tilt_released_ ||
+      heading_span_rad() < config_.gravity_tilt_release_yaw_rad) {
+    return;
+  }
+  // Until now no factor had the tilt (it was zero): the window was the plain one to the bit.
+  tilt_released_ = true;
+  add_gravity_tilt_prior();
+}
+
+void SlidingWindow::track_heading(const Eigen::Quaterniond& q_map_imu) {
+  const Eigen::Vector3d x_map = q_map_imu * Eigen::Vector3d::UnitX();
+  const double yaw = std::atan2(x_map.y(), x_map.x());
+  // States are a scan apart: the heading turns far less than half a turn between them.
+  heading_rad_ =
+      heading_rad_ ? *heading_rad_ + std::remainder(yaw - *heading_rad_, 2.0 * M_PI) : yaw;
+  if (!position_pinned_) return;
+  heading_min_rad_ = std::min(heading_min_rad_.value_or(*heading_rad_), *heading_rad_);
+  heading_max_rad_ = std::max(heading_max_rad_.value_or(*heading_rad_), *heading_rad_);
 }
 
 double* SlidingWindow::block(const BlockRef& ref) {
   if (ref.role == BlockRole::kGravityTilt) {
-    return config_.estimate_gravity_tilt ? gravity_tilt_ : nullptr;
+    return tilt_released_ ? gravity_tilt_ : nullptr;
   }
   const std::optional<std::size_t> i = index_of(ref.state_id);
   if (!i) return nullptr;
@@ -101,14 +132,9 @@ void SlidingWindow::reset(const imu::ImuState& state,
   add_factor(FactorKind::kPrior,
              std::make_unique<MarginalPrior>(std::move(blocks), J, Eigen::VectorXd::Zero(15)),
              {{s.id, BlockRole::kPose}, {s.id, BlockRole::kSpeedBias}});
-  if (config_.estimate_gravity_tilt) {
-    // The tilt found so far (the map stays), held as well as the start-up alignment levels.
-    std::vector<PriorBlock> tilt = {{2, std::vector<double>(gravity_tilt_, gravity_tilt_ + 2)}};
-    const Eigen::MatrixXd J_tilt = Eigen::MatrixXd::Identity(2, 2) / config_.gravity_tilt_prior_rad;
-    add_factor(FactorKind::kPrior,
-               std::make_unique<MarginalPrior>(std::move(tilt), J_tilt, Eigen::VectorXd::Zero(2)),
-               {{0, BlockRole::kGravityTilt}});
-  }
+  track_heading(state.q_map_imu);
+  if (tilt_released_) add_gravity_tilt_prior();
+  release_gravity_tilt_when_observable();
 }
 
 void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& pre,
@@ -119,6 +145,8 @@ void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& p
   s.id = next_id_++;
   s.stamp = guess.stamp;
   to_arrays(guess, s.pose, s.speed_bias);
+  track_heading(guess.q_map_imu);
+  release_gravity_tilt_when_observable();
   if (lidar) {
     add_factor(FactorKind::kLidarPose,
                std::make_unique<LidarPoseFactor>(lidar->T_map_lidar, config_.T_imu_lidar,
@@ -130,11 +158,9 @@ void SlidingWindow::add(const imu::ImuState& guess, const imu::Preintegration& p
                                   {*previous, BlockRole::kSpeedBias},
                                   {s.id, BlockRole::kPose},
                                   {s.id, BlockRole::kSpeedBias}};
-    if (config_.estimate_gravity_tilt) refs.push_back({0, BlockRole::kGravityTilt});
-    add_factor(
-        FactorKind::kImu,
-        std::make_unique<ImuFactor>(pre, config_.gravity_mps2, config_.estimate_gravity_tilt),
-        refs);
+    if (tilt_released_) refs.push_back({0, BlockRole::kGravityTilt});
+    add_factor(FactorKind::kImu,
+               std::make_unique<ImuFactor>(pre, config_.gravity_mps2, tilt_released_), refs);
   }
   while (static_cast<int>(states_.size()) > config_.size) marginalise_oldest();
 }
@@ -172,7 +198,10 @@ bool SlidingWindow::solve() {
     problem.AddParameterBlock(s.pose, 7, &pose_manifold());
     problem.AddParameterBlock(s.speed_bias, 9);
   }
-  if (config_.estimate_gravity_tilt) problem.AddParameterBlock(gravity_tilt_, 2);
+  if (tilt_released_) {
+    problem.AddParameterBlock(gravity_tilt_, 2);
+    ++counters_.solves_tilt_free;
+  }
   for (WindowFactor& f : factors_) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -253,7 +282,7 @@ Eigen::Matrix<double, 6, 6> SlidingWindow::latest_pose_covariance() const {
     layout.add(s.pose, 7);
     layout.add(s.speed_bias, 9);
   }
-  if (config_.estimate_gravity_tilt) layout.add(gravity_tilt_, 2);
+  if (tilt_released_) layout.add(gravity_tilt_, 2);
   const int n = layout.size;
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
   for (const WindowFactor& f : factors_) accumulate(f, layout, H, nullptr);

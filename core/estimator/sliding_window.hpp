@@ -36,6 +36,10 @@ struct SlidingWindowConfig {
   bool estimate_gravity_tilt = false;
   /// its prior at a reset, 1 sigma per axis [rad]
   double gravity_tilt_prior_rad = 0.02;
+  /// The tilt is held (a constant in the solve) until the heading has spanned this much since
+  /// the window began: driving one way, a tilt and a body-fixed accelerometer bias look the same,
+  /// and freeing the tilt there only weakens the IMU along the way driven [rad]. 0: never held.
+  double gravity_tilt_release_yaw_rad = 0.0;
 };
 
 /// A lidar pose measurement for one state.
@@ -49,7 +53,8 @@ struct SlidingWindowCounters {
   std::uint64_t solves = 0;
   std::uint64_t failed_solves = 0;
   std::uint64_t marginalised = 0;
-  std::uint64_t iterations = 0;  ///< summed over solves
+  std::uint64_t iterations = 0;        ///< summed over solves
+  std::uint64_t solves_tilt_free = 0;  ///< solves with the map's tilt a block of the window
   /// factors added, by FactorKind [1]
   std::array<std::uint64_t, kFactorKinds> factors_added{};
 };
@@ -99,6 +104,19 @@ class SlidingWindow {
   Eigen::Vector3d gravity_map() const;
   /// The estimated tilt of the map frame about its x and y [rad] (zero unless estimated).
   Eigen::Vector2d gravity_tilt() const { return {gravity_tilt_[0], gravity_tilt_[1]}; }
+  /// The caller's say on whether the lidar pins the position of the states it adds from now
+  /// (not along a corridor's axis, not on an open stretch). Only headings turned through at
+  /// pinned states count towards releasing the tilt: there a turn tells it from the bias. True
+  /// until said otherwise.
+  void set_position_pinned(bool pinned) { position_pinned_ = pinned; }
+  /// Whether the tilt is a block of the window yet: estimated, and the headings of pinned states
+  /// have spanned enough. From then on it stays one, through resets. Before, it is zero and no
+  /// factor has it: the window is the one without tilt estimation, to the bit.
+  bool gravity_tilt_free() const { return tilt_released_; }
+  /// The span of headings the window's states have had at pinned positions since it began [rad].
+  double heading_span_rad() const {
+    return heading_min_rad_ ? *heading_max_rad_ - *heading_min_rad_ : 0.0;
+  }
 
  private:
   struct State {
@@ -109,6 +127,9 @@ class SlidingWindow {
   };
   double* block(const BlockRef& ref);
   void marginalise_oldest();
+  void track_heading(const Eigen::Quaterniond& q_map_imu);  // of a state being added
+  void release_gravity_tilt_when_observable();
+  void add_gravity_tilt_prior();
 
   SlidingWindowConfig config_;
   std::deque<State> states_;  // references stay valid as states come and go at the ends
@@ -117,6 +138,12 @@ class SlidingWindow {
   SlidingWindowCounters counters_;
   // The map frame's tilt (kGravityTilt); kept through resets: the map it belongs to stays.
   double gravity_tilt_[2] = {0.0, 0.0};
+  // Heading (yaw of the IMU's x axis in map), unwrapped across states, and its extremes over
+  // pinned states [rad]; kept through resets like the tilt.
+  std::optional<double> heading_rad_;
+  std::optional<double> heading_min_rad_, heading_max_rad_;
+  bool position_pinned_ = true;
+  bool tilt_released_ = false;
 };
 
 }  // namespace posed::estimator

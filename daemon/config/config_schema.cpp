@@ -358,6 +358,11 @@ const Field kSchema[] = {
       "hides in the accelerometer bias, wrong after every turn"),
     F("estimator.gravity_tilt_prior_deg", estimator.gravity_tilt_prior_deg, "1", "deg", 0.01, 10,
       "", "the tilt's prior at a (re)start, 1 sigma per axis"),
+    F("estimator.gravity_tilt_release_heading_deg", estimator.gravity_tilt_release_heading_deg,
+      "45", "deg", 0, 720, "",
+      "the tilt is held (zero, and in no factor) until the heading has spanned this much at "
+      "scans whose position the lidar pins: driving one way, or turning where the lidar is "
+      "degenerate, a tilt and an accelerometer bias look the same (0: estimated from the start)"),
     F("estimator.solver_iterations", estimator.solver_iterations, "8", "", 1, 100, "",
       "Levenberg-Marquardt iterations of the window per scan"),
     F("estimator.max_speed_mps", estimator.max_speed_mps, "40", "m/s", 1, 200, "",

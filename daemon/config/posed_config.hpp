@@ -221,13 +221,15 @@ struct EstimatorSection {
   int window_size = 10;                 ///< states in the fixed-lag window [1]
   bool estimate_gravity_tilt = false;   ///< the map frame's tilt as a window block
   double gravity_tilt_prior_deg = 1.0;  ///< its prior at a (re)start, 1 sigma per axis [deg]
-  int solver_iterations = 8;            ///< Levenberg-Marquardt iterations per scan [1]
-  double max_speed_mps = 40;            ///< faster means diverged [m/s]
-  double max_gyro_bias_radps = 0.3;     ///< larger means diverged [rad/s]
-  double max_accel_bias_mps2 = 2.0;     ///< larger means diverged [m/s^2]
-  double max_match_jump_m = 1.0;        ///< a scan match further from the IMU prediction is refused
-  double max_match_jump_deg = 11.5;     ///< [deg]
-  bool degeneracy_handling = true;      ///< remap degenerate directions to the IMU prediction
+  /// held until the heading has spanned this much [deg]
+  double gravity_tilt_release_heading_deg = 45.0;
+  int solver_iterations = 8;         ///< Levenberg-Marquardt iterations per scan [1]
+  double max_speed_mps = 40;         ///< faster means diverged [m/s]
+  double max_gyro_bias_radps = 0.3;  ///< larger means diverged [rad/s]
+  double max_accel_bias_mps2 = 2.0;  ///< larger means diverged [m/s^2]
+  double max_match_jump_m = 1.0;     ///< a scan match further from the IMU prediction is refused
+  double max_match_jump_deg = 11.5;  ///< [deg]
+  bool degeneracy_handling = true;   ///< remap degenerate directions to the IMU prediction
   double degeneracy_translation_threshold = 10;  ///< point constraints [1]
   double degeneracy_rotation_threshold_m2 = 20;  ///< squared lever arms [m^2]
   double degenerate_information_scale = 0.01;    ///< what a scan says along them, weighed [-]

@@ -54,6 +54,7 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.window.max_iterations = e.solver_iterations;
   l.window.estimate_gravity_tilt = e.estimate_gravity_tilt;
   l.window.gravity_tilt_prior_rad = e.gravity_tilt_prior_deg * kDeg;
+  l.window.gravity_tilt_release_yaw_rad = e.gravity_tilt_release_heading_deg * kDeg;
   l.max_speed_mps = e.max_speed_mps;
   l.max_gyro_bias_radps = e.max_gyro_bias_radps;
   l.max_accel_bias_mps2 = e.max_accel_bias_mps2;
