@@ -78,6 +78,7 @@ void PoseSinks::new_pass() {
   // Until the new estimator's first optimised state, its propagation is decimated onto pose,
   // as on the first pass.
   tally_.have_optimised = false;
+  tally_.last_pose_stamp.reset();
   path_.clear();
 }
 
@@ -126,10 +127,14 @@ void PoseSinks::state(const NavState& s, const Eigen::Isometry3d& T_map_odom) {
   // propagation decimated onto pose.
   if (s.optimised) tally_.have_optimised = true;
   if (!s.optimised) odom(s);
-  const bool pose_now =
-      s.optimised || (!tally_.have_optimised && s.stamp >= tally_.next_pose_stamp);
+  bool pose_now = s.optimised || (!tally_.have_optimised && s.stamp >= tally_.next_pose_stamp);
+  if (pose_now && tally_.last_pose_stamp && s.stamp <= *tally_.last_pose_stamp) {
+    pose_now = false;
+    ++tally_.pose_out_of_order;
+  }
   if (pose_now) {
     tally_.next_pose_stamp = s.stamp + pose_period_;
+    tally_.last_pose_stamp = s.stamp;
     // The state is in the odometry frame (the estimator's); the pose goes out in map.
     dds::PoseMessage pose;
     pose.stamp = stamp;

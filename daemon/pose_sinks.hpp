@@ -86,6 +86,11 @@ struct PublishTally {
   std::optional<NavState> last;
   double distance_m = 0;
   HostTime next_pose_stamp;
+  /// the newest pose's stamp: a pose stream's stamps only increase
+  std::optional<HostTime> last_pose_stamp;
+  /// optimised states not after the newest pose, left off pose (the first scan can end just
+  /// before the IMU sample whose propagation went out while no optimised state had come) [1]
+  std::uint64_t pose_out_of_order = 0;
   /// the estimator publishes optimised states (so pose is not decimated from odom)
   bool have_optimised = false;
 };

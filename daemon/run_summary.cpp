@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "daemon/cloud_output.hpp"
 #include "daemon/estimator_summary.hpp"
@@ -267,11 +268,16 @@ bool print_run_summary(const RunSummary& r) {
   if (!r.published)
     std::printf("  published           nothing (offline run, no DDS)\n");
   else
-    std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s\n",
+    std::printf("  published           %llu odom, %llu pose, %llu status on DDS domain %d%s%s\n",
                 static_cast<unsigned long long>(tally.odom.load()),
                 static_cast<unsigned long long>(tally.pose),
                 static_cast<unsigned long long>(tally.status), r.config.dds.domain_id,
-                tally.failed.load() ? " (some writes failed)" : "");
+                tally.failed.load() ? " (some writes failed)" : "",
+                tally.pose_out_of_order > 0
+                    ? ("; " + std::to_string(tally.pose_out_of_order) +
+                       " state(s) left off pose: stamped before the pose already sent")
+                          .c_str()
+                    : "");
   if (r.published) {
     std::printf("  latency             %s\n",
                 r.sinks.odom_latency().line(r.sinks.live_clock()).c_str());
