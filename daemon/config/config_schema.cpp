@@ -352,7 +352,7 @@ const Field kSchema[] = {
       "largest rate still counted as standing still during alignment"),
     F("estimator.window_size", estimator.window_size, "10", "", 2, 50, "",
       "states in the lidar-inertial fixed-lag window"),
-    F("estimator.estimate_gravity_tilt", estimator.estimate_gravity_tilt, "false", "", 0, 0, "",
+    F("estimator.estimate_gravity_tilt", estimator.estimate_gravity_tilt, "true", "", 0, 0, "",
       "estimate the map frame's tilt (gravity's direction in map) in the window: the map is "
       "levelled only as well as the start-up alignment could, and what it misses otherwise "
       "hides in the accelerometer bias, wrong after every turn"),

@@ -219,7 +219,7 @@ struct EstimatorSection {
   double init_static_s = 1.0;           ///< IMU averaged for the gravity alignment [s]
   double init_max_gyro_radps = 0.05;    ///< above this the rig is not static [rad/s]
   int window_size = 10;                 ///< states in the fixed-lag window [1]
-  bool estimate_gravity_tilt = false;   ///< the map frame's tilt as a window block
+  bool estimate_gravity_tilt = true;    ///< the map frame's tilt as a window block
   double gravity_tilt_prior_deg = 1.0;  ///< its prior at a (re)start, 1 sigma per axis [deg]
   /// held until the heading has spanned this much [deg]
   double gravity_tilt_release_heading_deg = 45.0;
