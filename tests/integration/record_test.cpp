@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "drivers/recording/mcap_reader.hpp"
+#include "drivers/recording/recorder.hpp"
 #include "drivers/velodyne/calibration.hpp"
 #include "tests/integration/hil_helpers.hpp"
 #include "tests/integration/posed_process.hpp"
@@ -381,6 +382,41 @@ TEST(PosedReplay, RecordedConfigOfARecordingWithoutOneIsRefusedNamingTheFile) {
   ASSERT_EQ(replay.wait_for_exit(30s), 2) << replay.err();
   EXPECT_NE(replay.err().find(simulated + ": no recorded configuration"), std::string::npos)
       << replay.err();
+}
+
+// A recording whose pose stream went out of order (posed before 878f2f7 could send the back end's
+// first propagation, then a first scan state stamped 0.145 ms before it): posectl export leaves
+// the late one out, says so, and writes a TUM file posectl eval takes.
+TEST(PosectlExport, LeavesOutAPoseStampedBeforeTheOneBeforeAndSaysSo) {
+  TempDir dir;
+  const std::string recording = dir.file("poses.mcap");
+  {
+    drivers::recording::RecorderOptions opt;
+    opt.writer.fsync_on_close = false;
+    opt.in_push_order = true;  // as written, like posed's own pose stream
+    opt.host_to_wall.wall_minus_host = Duration::from_s(1'700'000'000);
+    drivers::recording::Recorder rec;
+    std::string error;
+    ASSERT_TRUE(rec.open(recording, opt, error)) << error;
+    for (const std::int64_t ns :
+         {1'027'275'528LL, 1'027'130'784LL, 1'127'106'600LL, 1'227'137'264LL}) {
+      ASSERT_TRUE(rec.write_pose("/posed/pose", WallTime::from_ns(1'700'000'000'000'000'000 + ns),
+                                 "map", {1e-9 * static_cast<double>(ns), 0, 0}, {0, 0, 0, 1}));
+    }
+    ASSERT_TRUE(rec.close());
+  }
+  const std::string tum = dir.file("poses.tum");
+  PosedProcess exporter({build_dir() + "/tools/posectl/posectl", "export", recording, "--tum", tum},
+                        {}, dir);
+  ASSERT_EQ(exporter.wait_for_exit(30s), 0) << exporter.err();
+  EXPECT_NE(exporter.err().find("3 poses from /posed/pose"), std::string::npos) << exporter.err();
+  EXPECT_NE(exporter.err().find("1 left out: stamped no later than the pose before"),
+            std::string::npos)
+      << exporter.err();
+  PosedProcess eval({build_dir() + "/tools/posectl/posectl", "eval", "--gt", tum, "--est", tum,
+                     "--align", "none"},
+                    {}, dir);
+  EXPECT_EQ(eval.wait_for_exit(30s), 0) << eval.err() << eval.out();
 }
 
 }  // namespace record_test

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -140,7 +141,8 @@ int run_export(int argc, char** argv) {
     std::fprintf(stderr, "posectl export: cannot create %s\n", tum_path.c_str());
     return 1;
   }
-  std::uint64_t written = 0, undecodable = 0;
+  std::uint64_t written = 0, undecodable = 0, out_of_order = 0;
+  std::optional<std::int64_t> last_stamp_ns;
   rec::McapMessage m;
   rec::ros2::StampedPose p;
   while (reader.next(m)) {
@@ -153,6 +155,13 @@ int run_export(int argc, char** argv) {
       ++undecodable;
       continue;
     }
+    // A TUM trajectory's stamps increase (posectl eval refuses it otherwise). Recordings from
+    // before posed kept /posed/pose in order could carry a first pose stamped after the second.
+    if (last_stamp_ns && p.stamp.ns <= *last_stamp_ns) {
+      ++out_of_order;
+      continue;
+    }
+    last_stamp_ns = p.stamp.ns;
     const std::string line =
         rec::tum_line(p.stamp.ns, Eigen::Vector3d(p.p_xyz_m[0], p.p_xyz_m[1], p.p_xyz_m[2]),
                       Eigen::Quaterniond(p.q_xyzw[3], p.q_xyzw[0], p.q_xyzw[1], p.q_xyzw[2]));
@@ -160,9 +169,12 @@ int run_export(int argc, char** argv) {
     ++written;
   }
   const bool write_ok = std::fclose(out) == 0;
-  std::fprintf(stderr, "posectl export: %llu poses from %s to %s (%llu undecodable)%s%s\n",
+  std::fprintf(stderr,
+               "posectl export: %llu poses from %s to %s (%llu undecodable, %llu left out: "
+               "stamped no later than the pose before)%s%s\n",
                static_cast<unsigned long long>(written), topic.c_str(), tum_path.c_str(),
                static_cast<unsigned long long>(undecodable),
+               static_cast<unsigned long long>(out_of_order),
                reader.complete() ? "" : "; recording damaged: ", reader.stop_reason().c_str());
   if (!write_ok) {
     std::fprintf(stderr, "posectl export: writing %s failed\n", tum_path.c_str());
