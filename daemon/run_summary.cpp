@@ -265,6 +265,11 @@ bool print_run_summary(const RunSummary& r) {
         c.mean_confidence[1], c.mean_confidence[2]);
   }
   print_visual_summary(st.estimator);
+  const std::string left_off_pose =
+      tally.pose_out_of_order > 0
+          ? "; " + std::to_string(tally.pose_out_of_order) +
+                " state(s) left off pose: stamped before the pose already sent"
+          : "";
   if (!r.published)
     std::printf("  published           nothing (offline run, no DDS)\n");
   else
@@ -272,12 +277,7 @@ bool print_run_summary(const RunSummary& r) {
                 static_cast<unsigned long long>(tally.odom.load()),
                 static_cast<unsigned long long>(tally.pose),
                 static_cast<unsigned long long>(tally.status), r.config.dds.domain_id,
-                tally.failed.load() ? " (some writes failed)" : "",
-                tally.pose_out_of_order > 0
-                    ? ("; " + std::to_string(tally.pose_out_of_order) +
-                       " state(s) left off pose: stamped before the pose already sent")
-                          .c_str()
-                    : "");
+                tally.failed.load() ? " (some writes failed)" : "", left_off_pose.c_str());
   if (r.published) {
     std::printf("  latency             %s\n",
                 r.sinks.odom_latency().line(r.sinks.live_clock()).c_str());

@@ -140,8 +140,6 @@ struct FusionFigures {
   /// estimator.estimate_gravity_tilt) [rad]
   Eigen::Vector2d gravity_tilt_rad = Eigen::Vector2d::Zero();
   bool gravity_tilt_estimated = false;
-  /// whether the tilt is free yet (it is held until the heading has spanned enough)
-  bool gravity_tilt_free = false;
   /// the span of headings driven so far [rad]
   double heading_span_rad = 0.0;
   /// window solves so far, and those with the tilt free [1]

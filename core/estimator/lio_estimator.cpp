@@ -52,7 +52,6 @@ FusionFigures LioEstimator::figures() const {
     f.gyro_bias_radps = anchor_->bias.gyro_radps;
     f.accel_bias_mps2 = anchor_->bias.accel_mps2;
     f.gravity_tilt_rad = window_.gravity_tilt();
-    f.gravity_tilt_free = window_.gravity_tilt_free();
     f.heading_span_rad = window_.heading_span_rad();
     f.window_solves = window_.counters().solves;
     f.window_solves_tilt_free = window_.counters().solves_tilt_free;
