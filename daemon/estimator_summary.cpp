@@ -35,9 +35,15 @@ void print_visual_summary(const FusionFigures& f) {
           v.residual_scale);
       continue;
     }
+    // A thermal stream on standby (estimator.camera_thermal_standby) says how long it waited.
+    char standby[64] = "";
+    if (v.standby > 0) {
+      std::snprintf(standby, sizeof standby, ", %llu on standby",
+                    static_cast<unsigned long long>(v.standby));
+    }
     std::printf(
         "  %-7s factors     %llu between factors (%llu from a keyframe) from %llu frames; gate %s "
-        "(left %llu, rejoined %llu times, %llu intervals gated out); %llu without frames, %llu "
+        "(left %llu, rejoined %llu times, %llu intervals gated out%s); %llu without frames, %llu "
         "failed, %llu implausible; last omega %.2f, confidence %.2f, %d inliers, %d still "
         "features left out, reprojection %.2f px, window residual median %.2f sigma, residual "
         "scale %.1f\n",
@@ -45,10 +51,10 @@ void print_visual_summary(const FusionFigures& f) {
         static_cast<unsigned long long>(v.keyframe_factors),
         static_cast<unsigned long long>(v.frames), v.active ? "open" : "closed",
         static_cast<unsigned long long>(v.left), static_cast<unsigned long long>(v.rejoined),
-        static_cast<unsigned long long>(v.gated_out), static_cast<unsigned long long>(v.no_frames),
-        static_cast<unsigned long long>(v.failed), static_cast<unsigned long long>(v.implausible),
-        v.omega, v.confidence, v.inliers, v.still, v.reprojection_rms_px, v.residual_median,
-        v.residual_scale);
+        static_cast<unsigned long long>(v.gated_out), standby,
+        static_cast<unsigned long long>(v.no_frames), static_cast<unsigned long long>(v.failed),
+        static_cast<unsigned long long>(v.implausible), v.omega, v.confidence, v.inliers, v.still,
+        v.reprojection_rms_px, v.residual_median, v.residual_scale);
   }
   const PoseSelectionFigures& s = f.selection;
   const std::uint64_t chosen =

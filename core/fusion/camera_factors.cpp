@@ -195,6 +195,12 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
       keyframe.reset();
       continue;
     }
+    if (standing_by(stream)) {
+      ++f.standby;
+      keyframe.reset();
+      thermal_gave_motion_ = false;
+      continue;
+    }
     // Landmarks alone: no frame-pair motion, not even for the checks (lidar reconciled, initial
     // value): on corridor seeds 17 and 20-22 the motions' initial values and the landmarks
     // disagreed, and the runs ended further off (18.3 m on seed 20 against 0.89 m without).
@@ -213,6 +219,7 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
     }
     if (motion) {
       out.push_back(*motion);
+      if (stream == 1) thermal_gave_motion_ = true;
       ++f.factors;
       if (*k < newest) ++f.keyframe_factors;
     }
@@ -224,9 +231,23 @@ void CameraFactors::relative_motions(const estimator::SlidingWindow& window,
   }
 }
 
+bool CameraFactors::standing_by(std::size_t stream) const {
+  if (stream != 1 || !config_.thermal_standby) return false;
+  for (const std::size_t other : {std::size_t{0}, std::size_t{2}}) {
+    if (config_.streams[other] && figures_[other].active) return true;
+  }
+  return false;
+}
+
 bool CameraFactors::active() const {
   for (std::size_t stream = 0; stream < 3; ++stream) {
-    if (config_.streams[stream] && figures_[stream].active) return true;
+    if (!config_.streams[stream] || !figures_[stream].active) continue;
+    if (stream == 1 && config_.thermal_standby) {
+      // Standing in, it counts once it gives motions: the lidar keeps its say along directions
+      // it cannot pin until then (on the corridor its gate stays open while every pair fails).
+      if (standing_by(stream) || !thermal_gave_motion_) continue;
+    }
+    return true;
   }
   return false;
 }
@@ -238,7 +259,7 @@ std::uint8_t CameraFactors::add_factors(estimator::SlidingWindow& window) {
   std::uint8_t modalities = 0;
   for (std::size_t stream = 0; stream < 3; ++stream) {
     if (!config_.streams[stream]) continue;
-    if (!figures_[stream].active) {
+    if (!figures_[stream].active || standing_by(stream)) {
       landmarks_[stream].clear();
       continue;
     }

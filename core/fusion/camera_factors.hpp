@@ -89,6 +89,14 @@ struct CameraFactorsConfig {
   /// the thermal and fused streams' gates never fall back to all observations
   /// (FrameMotionConfig::gate_falls_back): their fixed pattern can be the majority
   bool thermal_gate_strict = true;
+  /// with a visible (or fused) stream configured, the thermal stream's factors enter only while
+  /// that stream's gate is closed (smoke, darkness, a covered lens). On the simulator the
+  /// thermal stream's motions are poorer than the visible camera's wherever both see (its
+  /// corners are few and partly its own fixed pattern), and as an equal second stream it made
+  /// the corridor and tunnel worse; where the visible camera is blind it is all there is
+  /// (docs/estimator.md, "The thermal camera on standby"). Its front end runs throughout, so
+  /// its tracks and its fixed-pattern correction are ready when it is needed.
+  bool thermal_standby = false;
   /// Σ = ω Σ_base with ω from the image quality (seed 002); false: ω = 1
   bool quality_weighting = true;
   /// a stream whose confidence stays below this for `leave_frames` frames stops contributing,
@@ -186,6 +194,8 @@ class CameraFactors final : public estimator::WindowAiding {
                                                    std::size_t k, const imu::ImuState& next,
                                                    bool count_failure);
   void gate(std::size_t stream, double confidence, double gradient);
+  /// The thermal stream waits while another stream's gate is open (thermal_standby).
+  bool standing_by(std::size_t stream) const;
 
   CameraFactorsConfig config_;
   std::array<Stream, 3> streams_;
@@ -195,9 +205,10 @@ class CameraFactors final : public estimator::WindowAiding {
   std::array<HostTime, 3> observed_stamp_{};    // and that frame's stamp
   std::array<double, 3> residual_scale_{1.0, 1.0, 1.0};    // per stream, see residual_scaling
   std::array<std::optional<HostTime>, 3> keyframe_stamp_;  // per stream, see keyframe_states
-  bool lidar_weak_ = true;         // keyframes only then (see keyframe_states)
-  bool lidar_settled_ = false;     // strong_lidar_floor_translation_m only then
-  std::vector<double> residuals_;  // scratch
+  bool thermal_gave_motion_ = false;  // since it last stood by (thermal_standby, active())
+  bool lidar_weak_ = true;            // keyframes only then (see keyframe_states)
+  bool lidar_settled_ = false;        // strong_lidar_floor_translation_m only then
+  std::vector<double> residuals_;     // scratch
 };
 
 }  // namespace posed::fusion

@@ -417,6 +417,9 @@ const Field kSchema[] = {
       "a thermal or fused frame pair whose features mostly miss where the IMU puts them gives "
       "no motion (the visible stream then trusts the majority): a thermal camera's fixed pattern "
       "on uniform walls holds still while the robot moves"),
+    F("estimator.camera_thermal_standby", estimator.camera_thermal_standby, "false", "", 0, 0, "",
+      "with frontend.mode visible+thermal, the thermal stream's factors enter the estimate only "
+      "while the visible stream's gate is closed (smoke, darkness); its front end runs throughout"),
     F("estimator.camera_min_confidence", estimator.camera_min_confidence, "0.05", "", 0, 1, "",
       "a stream whose image confidence stays below this (3 frames) leaves the estimate"),
     F("estimator.camera_rejoin_confidence", estimator.camera_rejoin_confidence, "0.08", "", 0, 1,

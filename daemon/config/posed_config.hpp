@@ -244,6 +244,7 @@ struct EstimatorSection {
   bool camera_quality_weighting = true;       ///< Σ = ω Σ_base (seed 002); false: ω = 1
   bool camera_residual_scaling = true;        ///< and by their disagreement with the other stream
   bool camera_thermal_gate_strict = true;     ///< thermal majority off the IMU's guess: no motion
+  bool camera_thermal_standby = false;        ///< thermal factors only while visible is gated out
   double camera_min_confidence = 0.05;        ///< a stream below it leaves the estimate [0..1]
   double camera_rejoin_confidence = 0.08;     ///< and returns at or above it [0..1]
   double camera_min_gradient = 0.02;          ///< or below this gradient metric g [0..1]

@@ -151,6 +151,7 @@ fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& con
   c.quality_weighting = e.camera_quality_weighting;
   c.residual_scaling = e.camera_residual_scaling;
   c.thermal_gate_strict = e.camera_thermal_gate_strict;
+  c.thermal_standby = e.camera_thermal_standby;
   c.min_confidence = e.camera_min_confidence;
   c.rejoin_confidence = std::max(e.camera_rejoin_confidence, e.camera_min_confidence);
   c.min_gradient = e.camera_min_gradient;

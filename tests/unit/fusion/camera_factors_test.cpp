@@ -280,6 +280,63 @@ TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {
   EXPECT_EQ(factors.figures()[0].rejoined, 1u);
 }
 
+TEST(CameraFactors, TheThermalStreamStandsByWhileTheVisibleOneSeesAndStandsInWhenItIsBlind) {
+  const FactorsWorld world;
+  const auto run = [&](bool standby) {
+    CameraFactorsConfig c = factors_config();
+    c.streams = {true, true, false};
+    c.min_confidence = 0.2;
+    c.rejoin_confidence = 0.3;
+    c.thermal_standby = standby;
+    CameraFactors factors(c);
+    estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
+    double t_frame = 0.013;
+    const auto frames_until = [&](double t, double visible_confidence) {
+      for (; t_frame < t; t_frame += 1.0 / 15) {
+        factors.add_frame(vision::FrontendMode::kVisible, world.frame(t_frame, visible_confidence));
+        vision::FrontendFrame thermal = world.frame(t_frame, 0.9);  // smoke does not blind it
+        thermal.mode = vision::FrontendMode::kThermal;
+        thermal.quality.thermal = thermal.quality.visible;
+        factors.add_frame(vision::FrontendMode::kThermal, thermal);
+      }
+    };
+    // The kinds of factor a new state after `t_state` gets.
+    const auto kinds = [&](double t_state) {
+      std::vector<estimator::RelativeMotion> motions;
+      fill(window, t_state);
+      factors.relative_motions(window, state_at(t_state + 0.1), motions);
+      std::vector<estimator::FactorKind> out;
+      for (const estimator::RelativeMotion& m : motions) out.push_back(m.kind);
+      return out;
+    };
+    using K = estimator::FactorKind;
+    std::vector<std::vector<K>> steps;
+    frames_until(0.45, 0.9);
+    steps.push_back(kinds(0.3));
+    frames_until(0.85, 0.05);  // smoke: the visible stream's gate closes
+    EXPECT_FALSE(factors.figures()[0].active);
+    // On standby the thermal stream counts for the lidar once it has given a motion.
+    EXPECT_EQ(factors.active(), !standby);
+    steps.push_back(kinds(0.7));
+    EXPECT_TRUE(factors.active());
+    frames_until(1.55, 0.9);  // clear again
+    EXPECT_TRUE(factors.figures()[0].active);
+    steps.push_back(kinds(1.4));
+    return std::make_pair(steps, factors.figures()[1]);
+  };
+  using K = estimator::FactorKind;
+  const auto [standby, thermal] = run(true);
+  EXPECT_EQ(standby, (std::vector<std::vector<K>>{{K::kVisible}, {K::kThermal}, {K::kVisible}}));
+  EXPECT_EQ(thermal.standby, 2u);
+  EXPECT_EQ(thermal.factors, 1u);
+  EXPECT_TRUE(thermal.active);  // its own gate never closed
+
+  const auto [equal, thermal_equal] = run(false);
+  EXPECT_EQ(equal, (std::vector<std::vector<K>>{
+                       {K::kVisible, K::kThermal}, {K::kThermal}, {K::kVisible, K::kThermal}}));
+  EXPECT_EQ(thermal_equal.standby, 0u);
+}
+
 CameraFactorsConfig landmark_config() {
   CameraFactorsConfig c = factors_config();
   c.coupling = CameraCoupling::kLandmarks;
