@@ -135,6 +135,9 @@ struct FusionFigures {
   /// translation directions where a scan's weak information was dropped for disagreeing with
   /// the cameras [1]
   std::uint64_t lidar_directions_overruled = 0;
+  /// translation directions a scan pinned weakly where the cameras, blind, could not check
+  /// them: left to the IMU [1]
+  std::uint64_t lidar_directions_left_to_imu = 0;
   int degenerate_directions = 0;                              ///< in the last scan's match [1]
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  ///< current estimate [rad/s]
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]

@@ -463,7 +463,13 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
     aiding_->set_lidar_state({.weak = lidar_suspect_, .settled = lidar_settled_});
     aiding_->relative_motions(window_, predicted, motions_);
   }
-  if (lidar_factor && !motions_.empty() && lidar_suspect_) reconcile(*lidar_factor);
+  if (lidar_factor && lidar_suspect_) {
+    if (!motions_.empty()) {
+      reconcile(*lidar_factor);
+    } else if (aiding_ != nullptr) {
+      leave_weak_directions_to_imu(*lidar_factor);
+    }
+  }
   const imu::ImuState initial = initial_value(predicted, pre, match);
   // The states the motions start from, by id: adding a state may marginalise the oldest.
   from_ids_.clear();
@@ -534,6 +540,24 @@ void LioEstimator::reconcile(LidarPose& lidar) {
     ++figures_.lidar_directions_overruled;
   }
   lidar.information = P * lidar.information * P.transpose();
+}
+
+void LioEstimator::leave_weak_directions_to_imu(LidarPose& lidar) {
+  if (config_.aided_blind_weak_ratio <= 0) return;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  const Eigen::Matrix3d I_t = lidar.information.bottomRightCorner<3, 3>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (I_t + I_t.transpose()));
+  // Ascending: only a tube's signature, one weak translation under two firm ones. Elsewhere
+  // (a corridor's end wall in a U-turn, with the camera's gate closed for a few frames) the IMU
+  // alone would carry two directions through a fast turn: corridor seed 34 ran away 69 m so.
+  const Eigen::Vector3d lambda = es.eigenvalues();
+  const double firm = config_.aided_blind_weak_ratio * lambda(2);
+  if (lambda(0) >= firm || lambda(1) < firm) return;
+  const Eigen::Vector3d e = es.eigenvectors().col(0);
+  Mat6 P = Mat6::Identity();
+  P.block<3, 3>(3, 3) -= e * e.transpose();
+  lidar.information = P * lidar.information * P.transpose();
+  ++figures_.lidar_directions_left_to_imu;
 }
 
 imu::ImuState LioEstimator::initial_value(const imu::ImuState& predicted,

@@ -488,6 +488,12 @@ const Field kSchema[] = {
       "the scan is checked against the cameras only this long after a scan with a degenerate "
       "direction: where the lidar has not shown it is lost (an open street) its weak directions "
       "are right"),
+    F("estimator.camera_blind_weak_lidar_ratio", estimator.camera_blind_weak_lidar_ratio, "0.5", "",
+      0, 1, "",
+      "where the scan would be checked but the cameras give no motion (gated out by smoke or "
+      "darkness, or every frame pair failed), a translation it pins with less than this share of "
+      "its best-pinned translation's information says nothing and the IMU carries it (0: off): "
+      "in a roadway the scans hold the axis still"),
     F("estimator.pose_selection", estimator.pose_selection, "true", "", 0, 0, "",
       "seed 001's adaptive pose selection: each state starts from the lidar, camera or fused "
       "odometry by the dynamic-threshold rule (false: the IMU prediction)"),

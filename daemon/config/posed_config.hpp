@@ -268,6 +268,8 @@ struct EstimatorSection {
   double camera_lidar_trusted_constraints = 200;  ///< above: a scan's direction is not checked [1]
   double camera_lidar_consistency_sigma = 3;      ///< scan vs cameras disagreement allowed
   double camera_lidar_suspect_window_s = 5;  ///< checked only this long after a degenerate scan [s]
+  double camera_blind_weak_lidar_ratio = 0.5;  ///< cameras blind there: weaker than this share of
+                                               ///< the scan's best translation, left to the IMU
 };
 
 /// One pipeline thread: SCHED_FIFO priority (0 = normal scheduling) and CPU (-1 = any).

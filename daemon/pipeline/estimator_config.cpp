@@ -69,6 +69,7 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
       (l.lidar.matcher.residual_sigma_m * l.lidar.matcher.residual_sigma_m);
   l.aided_consistency_sigma = e.camera_lidar_consistency_sigma;
   l.aided_suspect_window_s = e.camera_lidar_suspect_window_s;
+  l.aided_blind_weak_ratio = e.camera_blind_weak_lidar_ratio;
   l.aided_settled_after_s = e.camera_strong_lidar_after_s;
   return l;
 }
