@@ -154,8 +154,8 @@ class LioEstimator final : public FusionCore {
   /// Drops the scan's information along weakly pinned translations where it disagrees with the
   /// aiding's motions for this interval (see aided_trusted_information).
   void reconcile(LidarPose& lidar);
-  /// The scan's weakly pinned translations, unchecked while the cameras are blind, say nothing
-  /// (aided_blind_weak_ratio).
+  /// The scan's one weakly pinned translation under two firm ones, unchecked while the cameras
+  /// are blind, says nothing (aided_blind_weak_ratio).
   void leave_weak_directions_to_imu(LidarPose& lidar);
   /// Seed 001's choice among the IMU prediction, the scan match and the aiding's motions.
   imu::ImuState initial_value(const imu::ImuState& predicted, const imu::Preintegration& pre,
