@@ -3,24 +3,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <nanoflann.hpp>
 #include <numbers>
 
 namespace posed::vision {
 namespace {
-
-/// nanoflann's view of the polar keys.
-struct PolarCloud {
-  const std::vector<Eigen::Vector2f>* keys = nullptr;
-  std::size_t kdtree_get_point_count() const { return keys->size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t dim) const {
-    return (*keys)[i][static_cast<int>(dim)];
-  }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
 
 /// atan(t) to 2e-8 rad: Abramowitz & Stegun 4.4.49 on [-1, 1], atan(t) = pi/2 - atan(1/t)
 /// beyond. Twice for each of ~10k points per frame, where std::atan2 cost a third of the step.
@@ -48,20 +34,8 @@ Eigen::Vector2f polar_of(double x, double y, double z) {
 
 }  // namespace
 
-struct DepthAssociator::Tree {
-  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PolarCloud>,
-                                                    PolarCloud, 2, std::uint32_t>;
-  PolarCloud cloud;
-  Index index;
-  explicit Tree(const std::vector<Eigen::Vector2f>* keys)
-      : cloud{keys},
-        index(2, cloud,
-              nanoflann::KDTreeSingleIndexAdaptorParams(
-                  10, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex)) {}
-};
-
 DepthAssociator::DepthAssociator(const DepthConfig& config, const PinholeCamera& camera)
-    : config_(config), tree_(std::make_unique<Tree>(&polar_)) {
+    : config_(config) {
   // The image's field of view in polar coordinates: the undistorted rays of its border pixels.
   azimuth_min_ = elevation_min_ = 1e9;
   azimuth_max_ = elevation_max_ = -1e9;
@@ -144,15 +118,79 @@ void DepthAssociator::set_points(std::span<const Eigen::Vector3f> p_cam_m) {
     }
     cell_range_[c] = r2;
   }
-  // In cell order (deterministic, and neighbouring keys stay close in memory).
+  // In cell order (deterministic, and neighbouring keys stay close in memory); each cell now
+  // names its point in points_.
   points_.clear();
   polar_.clear();
-  for (const std::int32_t i : cell_best_) {
+  for (std::int32_t& i : cell_best_) {
     if (i < 0) continue;
+    const auto point = static_cast<std::int32_t>(points_.size());
     points_.push_back(candidates_[static_cast<std::size_t>(i)]);
     polar_.push_back(candidate_polar_[static_cast<std::size_t>(i)]);
+    i = point;
   }
-  tree_->index.buildIndex();
+}
+
+std::size_t DepthAssociator::nearest(const Eigen::Vector2f& key, double max_key_distance_rad,
+                                     std::size_t wanted, std::uint32_t* index,
+                                     float* distance_sq) const {
+  if (wanted == 0 || points_.empty()) return 0;
+  const double cell = std::max(config_.cell_rad, 1e-5);
+  const auto cell_of = [](double offset, int cells) {
+    return std::clamp(static_cast<int>(std::floor(offset)), 0, cells - 1);
+  };
+  const int qx = cell_of((key.x() - azimuth_min_) / cell, cells_x_);
+  const int qy = cell_of((key.y() - elevation_min_) / cell, cells_y_);
+  const float max_sq = static_cast<float>(max_key_distance_rad * max_key_distance_rad);
+  std::size_t found = 0;
+  // Kept sorted by (distance, index): ties go to the earlier point, whatever the visiting order.
+  const auto offer = [&](std::uint32_t i) {
+    const Eigen::Vector2f& p = polar_[i];
+    // As a kd-tree over float keys computes it, so the order is the same.
+    const float dx = key.x() - p.x();
+    float d = dx * dx;
+    const float dy = key.y() - p.y();
+    d += dy * dy;
+    if (d > max_sq) return;
+    const auto before = [&](std::size_t k) {
+      return distance_sq[k] < d || (distance_sq[k] == d && index[k] < i);
+    };
+    if (found == wanted && before(found - 1)) return;
+    std::size_t k = found < wanted ? found++ : wanted - 1;
+    for (; k > 0 && !before(k - 1); --k) {
+      distance_sq[k] = distance_sq[k - 1];
+      index[k] = index[k - 1];
+    }
+    distance_sq[k] = d;
+    index[k] = i;
+  };
+  const auto visit = [&](int x, int y) {
+    if (x < 0 || y < 0 || x >= cells_x_ || y >= cells_y_) return;
+    const std::int32_t i =
+        cell_best_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cells_x_) +
+                   static_cast<std::size_t>(x)];
+    if (i >= 0) offer(static_cast<std::uint32_t>(i));
+  };
+  // Square rings of cells around the key's cell, nearest first. A point in ring r + 1 or beyond
+  // lies at least r cells' width from the key in azimuth or elevation (less a margin for the
+  // keys' float rounding), so once the wanted points are nearer than that, or that is beyond the
+  // radius, no further ring can change the answer.
+  const int rings = std::max({qx, cells_x_ - 1 - qx, qy, cells_y_ - 1 - qy});
+  for (int r = 0; r <= rings; ++r) {
+    for (int x = qx - r; x <= qx + r; ++x) {
+      visit(x, qy - r);
+      if (r > 0) visit(x, qy + r);
+    }
+    for (int y = qy - r + 1; y <= qy + r - 1; ++y) {
+      visit(qx - r, y);
+      visit(qx + r, y);
+    }
+    const double gap = static_cast<double>(r) * cell - 1e-5;
+    if (gap > max_key_distance_rad) break;
+    if (found == wanted && gap > 0 && static_cast<double>(distance_sq[found - 1]) < gap * gap)
+      break;
+  }
+  return found;
 }
 
 DepthResult DepthAssociator::depth(const Eigen::Vector2d& normalised) const {
@@ -165,9 +203,23 @@ DepthResult DepthAssociator::depth(const Eigen::Vector2d& normalised) const {
       static_cast<std::size_t>(std::max(config_.candidates, 3)), 3, kMaxCandidates);
   std::array<std::uint32_t, kMaxCandidates> index{};
   std::array<float, kMaxCandidates> distance_sq{};
-  const std::size_t found =
-      tree_->index.knnSearch(key.data(), wanted, index.data(), distance_sq.data());
-  if (found < 3) return result;
+  // Only points within max_neighbour_angle_rad of the ray are ever used (the first three must
+  // be, and the search for a third point stops at the first that is not), so the search looks no
+  // further than the polar-key distance such a point can have. Between bearings at elevations
+  // e1, e2 a key distance d means an angle theta with sin(theta / 2) >= sqrt(cos e1 cos e2)
+  // sin(d / 2) (haversine, and sin(u) / u falling on [0, pi/2]): beyond that radius every
+  // point is further than the allowed angle.
+  const double cos_elevations =
+      std::sqrt(std::cos(std::max(std::abs(elevation_min_), std::abs(elevation_max_))) *
+                std::cos(std::abs(static_cast<double>(key.y()))));
+  const double sin_half = std::sin(config_.max_neighbour_angle_rad / 2) / cos_elevations;
+  const double radius = sin_half < 1.0 ? 2 * std::asin(sin_half) * (1 + 1e-4) + 1e-6
+                                       : std::numeric_limits<double>::infinity();
+  const std::size_t found = nearest(key, radius, wanted, index.data(), distance_sq.data());
+  if (found < 3) {
+    result.status = DepthStatus::kTooFar;
+    return result;
+  }
 
   // Candidates nearest first; each must lie within the search radius (true angle, not the
   // polar-key distance). The first two are the paper's nearest two.

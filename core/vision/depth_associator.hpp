@@ -1,14 +1,14 @@
 #pragma once
 // Lidar depth for visual features, seed 000 §2.2.1 (Fig. 4, 5), after LVI-SAM (Shan et al. 2021):
 // recent deskewed lidar points, stacked over several scans by the caller and given in the camera
-// frame, go onto the unit sphere around the camera; a 2-D kd-tree over their polar coordinates
-// finds the 3 nearest to each feature's bearing; the feature's depth is where its ray meets the
-// plane of those 3 points. Stacking scans mixes points of different surfaces, so a feature is
-// given no depth when its 3 points span more than `max_span_m` (2 m, seed 000).
+// frame, go onto the unit sphere around the camera; a nearest-neighbour search over their polar
+// coordinates finds the 3 nearest to each feature's bearing; the feature's depth is where its ray
+// meets the plane of those 3 points. Stacking scans mixes points of different surfaces, so a
+// feature is given no depth when its 3 points span more than `max_span_m` (2 m, seed 000).
 //
 // Definitions (seed 000 says "the largest distance between the 3 points"):
 //  - polar coordinates of a point p = (x, y, z) in the camera frame (x right, y down, z forward):
-//    azimuth atan2(x, z), elevation atan2(y, hypot(x, z)) [rad]; the kd-tree's 2-D keys.
+//    azimuth atan2(x, z), elevation atan2(y, hypot(x, z)) [rad]; the search's 2-D keys.
 //  - span (SpanMeasure::kMaxPairwiseDistance, default): max |P_i - P_j| over the 3 pairs [m], the
 //    paper's definition. kRangeSpread, max |P_i| - min |P_i| [m], is LVI-SAM's code; it accepts
 //    any triangle on a surface facing the camera however wide, so it is weaker at depth edges.
@@ -20,10 +20,15 @@
 // plane and clamps the intersection into the points' range interval, which invents a depth).
 // Beyond seed 000 a feature also gets no depth when its points are further than
 // `max_neighbour_angle_rad` from its bearing, collinear after all, seen edge-on, or when the
-// intersection lies outside their range interval by more than `max_extrapolation_m`. Before the
-// tree is built the points are culled to the camera's field of view and thinned to the nearest
-// point per `cell_rad` cell of the polar grid (LVI-SAM does the same), so nearer surfaces hide the
-// ones behind them.
+// intersection lies outside their range interval by more than `max_extrapolation_m`. The points
+// are culled to the camera's field of view and thinned to the nearest point per `cell_rad` cell
+// of a polar grid (LVI-SAM does the same), so nearer surfaces hide the ones behind them.
+//
+// The search walks that grid's cells in square rings around the bearing's cell (LVI-SAM and an
+// earlier posed built a kd-tree over the points for each frame; for the few hundred features of
+// a frame the tree's build cost more than all the searches) and gives exactly the tree's answer:
+// the nearest keys by the same float distance, up to the radius beyond which no point can lie
+// within `max_neighbour_angle_rad` of the bearing.
 
 #include <Eigen/Core>
 #include <cmath>
@@ -82,23 +87,31 @@ class DepthAssociator {
   /// Depth of the feature at normalised undistorted coordinates (x/z, y/z).
   DepthResult depth(const Eigen::Vector2d& normalised) const;
 
-  /// Points in the tree after culling and thinning [1].
+  /// Points kept after culling and thinning [1].
   std::size_t tree_points() const { return points_.size(); }
 
+  /// The kept points' polar keys (azimuth, elevation) [rad], in the order nearest() indexes.
+  const std::vector<Eigen::Vector2f>& keys() const { return polar_; }
+
+  /// The `wanted` points whose polar keys (azimuth, elevation) lie nearest `key` and within
+  /// `max_key_distance_rad` of it, nearest first (ties: the earlier point), as indices into the
+  /// kept points with their squared key distances [rad^2]; returns how many were found.
+  std::size_t nearest(const Eigen::Vector2f& key, double max_key_distance_rad, std::size_t wanted,
+                      std::uint32_t* index, float* distance_sq) const;
+
  private:
-  struct Tree;
   DepthConfig config_;
   double azimuth_min_ = 0, azimuth_max_ = 0, elevation_min_ = 0, elevation_max_ = 0;
   // Normalised-plane bounds for the cheap first cull (before any trigonometry).
   double x_min_ = 0, x_max_ = 0, y_min_ = 0, y_max_ = 0;
   int cells_x_ = 0, cells_y_ = 0;
-  std::vector<std::int32_t> cell_best_;  // index into candidates_, -1 = empty
+  // per polar cell: index into candidates_ while thinning, then into points_; -1 = empty
+  std::vector<std::int32_t> cell_best_;
   std::vector<float> cell_range_;
   std::vector<Eigen::Vector3f> candidates_;
   std::vector<Eigen::Vector2f> candidate_polar_;
-  std::vector<Eigen::Vector3f> points_;  // in the tree
+  std::vector<Eigen::Vector3f> points_;  // kept, in cell order
   std::vector<Eigen::Vector2f> polar_;   // their keys (azimuth, elevation) [rad]
-  std::unique_ptr<Tree> tree_;
 };
 
 }  // namespace posed::vision

@@ -6,10 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <opencv2/core.hpp>
+#include <utility>
+#include <vector>
 
 #include "tests/unit/vision/synthetic_scene.hpp"
 
@@ -171,6 +176,59 @@ TEST(DepthAssociator, CollinearNeighboursGiveNoDepth) {
   }
   depth.set_points(line);
   EXPECT_EQ(depth.depth({0.1, 0.0}).status, DepthStatus::kDegenerate);
+}
+
+TEST(DepthAssociator, TheRingSearchFindsExactlyTheNearestKeysABruteForceSearchFinds) {
+  DepthAssociator depth({}, scene::m2dgr_visible());
+  // Two stacked sweeps of a room-like scene with a gap in it: dense rings, sparse rings, a hole
+  // with no returns (the search must walk out of it) and points at the field of view's edges.
+  auto cloud = sweep(
+      [](const Eigen::Vector3d& d) {
+        if (d.x() > 0.1 && d.x() < 0.3) return -1.0;  // no returns: an open door
+        return plane_range(d, 6.0, -0.2);
+      },
+      32, 0.2);
+  const auto second =
+      sweep([](const Eigen::Vector3d& d) { return plane_range(d, 3.0, 0.5); }, 7, 0.7);
+  cloud.insert(cloud.end(), second.begin(), second.end());
+  depth.set_points(cloud);
+  const std::vector<Eigen::Vector2f>& keys = depth.keys();
+  ASSERT_GT(keys.size(), 1000u);
+
+  cv::RNG rng(11);
+  std::array<std::uint32_t, 32> index{};
+  std::array<float, 32> distance_sq{};
+  std::vector<std::pair<float, std::uint32_t>> all;
+  int compared = 0, short_of_wanted = 0;
+  for (int q = 0; q < 2000; ++q) {
+    // Inside and around the field of view (+-40 deg azimuth, +-30 deg elevation and beyond).
+    const Eigen::Vector2f key(static_cast<float>(rng.uniform(-0.8, 0.8)),
+                              static_cast<float>(rng.uniform(-0.6, 0.6)));
+    const std::size_t wanted = static_cast<std::size_t>(rng.uniform(1, 33));
+    const double radius =
+        q % 3 == 0 ? std::numeric_limits<double>::infinity() : rng.uniform(0.001, 0.08);
+    all.clear();
+    for (std::uint32_t i = 0; i < keys.size(); ++i) {
+      const float dx = key.x() - keys[i].x();
+      float d = dx * dx;
+      const float dy = key.y() - keys[i].y();
+      d += dy * dy;
+      if (d <= static_cast<float>(radius * radius)) all.emplace_back(d, i);
+    }
+    std::sort(all.begin(), all.end());
+    const std::size_t expected = std::min(wanted, all.size());
+    const std::size_t found = depth.nearest(key, radius, wanted, index.data(), distance_sq.data());
+    ASSERT_EQ(found, expected) << "query " << q << " at " << key.transpose();
+    for (std::size_t k = 0; k < found; ++k) {
+      ASSERT_EQ(index[k], all[k].second) << "query " << q << ", neighbour " << k;
+      ASSERT_EQ(distance_sq[k], all[k].first);
+    }
+    ++compared;
+    if (found < wanted) ++short_of_wanted;
+  }
+  EXPECT_EQ(compared, 2000);
+  EXPECT_GT(short_of_wanted, 100);  // the radius limited some searches
+  EXPECT_LT(short_of_wanted, 1900);
 }
 
 }  // namespace
