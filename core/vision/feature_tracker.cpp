@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "core/vision/corner_selection.hpp"
+
 namespace posed::vision {
 
 int reject_with_fundamental(const std::vector<cv::Point2f>& previous,
@@ -134,13 +136,10 @@ TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask
   return stats;
 }
 
-void FeatureTracker::mask_weak_corners(const cv::Mat& image) {
-  cv::cornerMinEigenVal(image, corner_score_, config_.corner_block_size, 3);
-  scores_.assign(corner_score_.begin<float>(), corner_score_.end<float>());
-  if (scores_.empty()) return;
-  const auto mid = scores_.begin() + static_cast<std::ptrdiff_t>(scores_.size() / 2);
-  std::nth_element(scores_.begin(), mid, scores_.end());
-  const double threshold = config_.corner_noise_factor * static_cast<double>(*mid);
+void FeatureTracker::mask_weak_corners() {
+  if (corner_score_.empty()) return;
+  const float median = nth_smallest(corner_score_, corner_score_.total() / 2);
+  const double threshold = config_.corner_noise_factor * static_cast<double>(median);
   cv::Mat strong;
   cv::compare(corner_score_, threshold, strong, cv::CMP_GT);
   cv::bitwise_and(mask_, strong, mask_);
@@ -195,9 +194,10 @@ void FeatureTracker::detect(const cv::Mat& grey, const cv::Mat& detect_mask, Tra
 
   const int wanted = config_.max_features - static_cast<int>(tracks_.size());
   if (wanted <= 0) return;
-  if (config_.corner_noise_factor > 0) mask_weak_corners(image);
-  cv::goodFeaturesToTrack(image, corners_, wanted, config_.corner_quality, min_distance, mask_,
-                          config_.corner_block_size);
+  // cv::goodFeaturesToTrack in two halves, so the score image serves the noise mask as well.
+  cv::cornerMinEigenVal(image, corner_score_, config_.corner_block_size, 3);
+  if (config_.corner_noise_factor > 0) mask_weak_corners();
+  select_corners(corner_score_, mask_, wanted, config_.corner_quality, min_distance, corners_);
   const float border = static_cast<float>(config_.border_px);
   for (cv::Point2f c : corners_) {
     // Level pixel x covers full-resolution pixels [x s, x s + s - 1]: centre (x + 0.5) s - 0.5.

@@ -94,7 +94,8 @@ class FeatureTracker {
   Eigen::Vector2d normalise(const cv::Point2f& pixel) const;
   void detect(const cv::Mat& grey, const cv::Mat& detect_mask, TrackStats& stats);
   /// Clears mask_ where the corner score is within corner_noise_factor of the median.
-  void mask_weak_corners(const cv::Mat& image);
+  /// (from corner_score_, the detection level's cv::cornerMinEigenVal)
+  void mask_weak_corners();
 
   TrackerConfig config_;
   PinholeCamera camera_;
@@ -109,7 +110,6 @@ class FeatureTracker {
   std::vector<std::size_t> order_;
   cv::Mat mask_;  // at the detection level's resolution
   cv::Mat corner_score_;
-  std::vector<float> scores_;
 };
 
 }  // namespace posed::vision
