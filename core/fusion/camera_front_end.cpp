@@ -1,6 +1,7 @@
 #include "core/fusion/camera_front_end.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -111,16 +112,28 @@ void CameraFrontEnd::process(const Eigen::Vector3d& gyro_bias_radps) {
 
 namespace {
 
-/// FNV-1a over an image's rows (its padding excluded).
+/// A 64-bit hash of an image's rows, to tell a repeated frame from a new one. FNV-1a's step on
+/// 8-byte words in four independent lanes: byte by byte, one multiply waiting for the last, it
+/// cost a millisecond per 640x512 16-bit thermal frame. A word that differs always changes its
+/// lane, and the lanes are folded so that a changed lane always changes the hash.
 std::uint64_t image_hash(const Image& image) {
+  constexpr std::uint64_t kPrime = 1099511628211ull;
   const std::span<const std::byte> bytes = image.pixels.bytes();
-  const std::size_t row = image.stride, rows = image.height;
-  std::uint64_t h = 1469598103934665603ull;
-  for (std::size_t r = 0; r < rows && (r + 1) * row <= bytes.size(); ++r) {
-    for (std::size_t i = r * row; i < (r + 1) * row; ++i) {
-      h = (h ^ static_cast<std::uint64_t>(bytes[i])) * 1099511628211ull;
+  const std::size_t size =
+      std::min(bytes.size(), static_cast<std::size_t>(image.stride) * image.height);
+  std::array<std::uint64_t, 4> lane = {1469598103934665603ull, 1469598103934665603ull ^ 1,
+                                       1469598103934665603ull ^ 2, 1469598103934665603ull ^ 3};
+  std::size_t i = 0;
+  for (; i + 32 <= size; i += 32) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, bytes.data() + i + 8 * k, sizeof word);
+      lane[k] = (lane[k] ^ word) * kPrime;
     }
   }
+  for (; i < size; ++i) lane[0] = (lane[0] ^ static_cast<std::uint64_t>(bytes[i])) * kPrime;
+  std::uint64_t h = lane[0];
+  for (std::size_t k = 1; k < 4; ++k) h = (h * kPrime) ^ lane[k];
   return h;
 }
 
