@@ -14,13 +14,14 @@ namespace posed::vision {
 
 int reject_with_fundamental(const std::vector<cv::Point2f>& previous,
                             const std::vector<cv::Point2f>& current, double threshold_px,
-                            double confidence, std::vector<std::uint8_t>& inlier) {
+                            double confidence, int max_iterations,
+                            std::vector<std::uint8_t>& inlier) {
   CV_Assert(previous.size() == current.size());
   inlier.assign(previous.size(), 1);
   if (previous.size() < 8) return static_cast<int>(previous.size());
   std::vector<std::uint8_t> mask;
-  const cv::Mat F =
-      cv::findFundamentalMat(previous, current, cv::FM_RANSAC, threshold_px, confidence, mask);
+  const cv::Mat F = cv::findFundamentalMat(previous, current, cv::FM_RANSAC, threshold_px,
+                                           confidence, std::max(1, max_iterations), mask);
   if (F.empty() || mask.size() != previous.size()) return static_cast<int>(previous.size());
   int count = 0;
   for (std::size_t i = 0; i < mask.size(); ++i) {
@@ -107,9 +108,9 @@ TrackStats FeatureTracker::track(const cv::Mat& grey, const cv::Mat& detect_mask
     }
     stats.klt_tracked = static_cast<int>(from_undistorted_.size());
     if (config_.ransac) {
-      stats.ransac_inliers =
-          reject_with_fundamental(from_undistorted_, to_undistorted_, config_.ransac_threshold_px,
-                                  config_.ransac_confidence, inlier_);
+      stats.ransac_inliers = reject_with_fundamental(
+          from_undistorted_, to_undistorted_, config_.ransac_threshold_px,
+          config_.ransac_confidence, config_.ransac_max_iterations, inlier_);
     } else {
       inlier_.assign(from_undistorted_.size(), 1);
       stats.ransac_inliers = stats.klt_tracked;

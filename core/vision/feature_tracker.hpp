@@ -33,8 +33,12 @@ struct TrackerConfig {
   bool ransac = true;                    ///< fundamental-matrix outlier rejection
   double ransac_threshold_px = 1.0;      ///< distance to the epipolar line [px]
   double ransac_confidence = 0.99;       ///< [0..1]
-  double corner_quality = 0.01;          ///< Shi-Tomasi: fraction of the best corner's score [-]
-  int corner_block_size = 3;             ///< Shi-Tomasi window [px]
+  /// RANSAC's draws at most. OpenCV draws until the confidence is reached for the inlier share
+  /// found so far, up to this: 1000 (its default) is the 99 % for 48 % inliers, and draws on a
+  /// frame in smoke or darkness, where few tracks agree, cost several milliseconds [1]
+  int ransac_max_iterations = 1000;
+  double corner_quality = 0.01;  ///< Shi-Tomasi: fraction of the best corner's score [-]
+  int corner_block_size = 3;     ///< Shi-Tomasi window [px]
   /// pyramid level new corners are detected on (0 = full resolution): on 640x480 the Shi-Tomasi
   /// response costs ~3 ms at level 0, a quarter at level 1, and KLT then tracks the patch
   /// around the corner wherever within its pixel it was placed [1]
@@ -72,7 +76,8 @@ struct TrackStats {
 /// (OpenCV's RANSAC seeds its generator on every call). Returns the inlier count.
 int reject_with_fundamental(const std::vector<cv::Point2f>& previous,
                             const std::vector<cv::Point2f>& current, double threshold_px,
-                            double confidence, std::vector<std::uint8_t>& inlier);
+                            double confidence, int max_iterations,
+                            std::vector<std::uint8_t>& inlier);
 
 class FeatureTracker {
  public:

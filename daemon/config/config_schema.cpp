@@ -550,6 +550,10 @@ const Field kSchema[] = {
       "distance to the epipolar line beyond which a track is an outlier (the back end checks "
       "the survivors against the IMU's motion; a tight threshold on a forward-moving camera "
       "drops half of the good tracks)"),
+    F("frontend.ransac_max_iterations", frontend.ransac_max_iterations, "200", "", 1, 100000, "",
+      "RANSAC draws at most per frame pair: the 99 % confidence for 58 % inliers (OpenCV's "
+      "1000: 48 %); where fewer tracks agree (smoke, darkness) its draws cost milliseconds a "
+      "frame and the motion is gated out anyway (docs/realtime.md, stop 51)"),
     F("frontend.forward_backward_px", frontend.forward_backward_px, "0.5", "px", 0.05, 10, "",
       "a track is kept when KLT, run back from the new frame, lands within this of where it "
       "started (docs/estimator.md: 1 px tracked 65 % of the simulated corridor's features per "

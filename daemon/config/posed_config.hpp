@@ -203,6 +203,7 @@ struct FrontendSection {
   int max_features = 300;
   double min_feature_distance_px = 20;  ///< [px]
   double ransac_threshold_px = 4;       ///< [px]
+  int ransac_max_iterations = 200;      ///< RANSAC's draws at most [1]
   double forward_backward_px = 0.5;     ///< KLT round-trip error allowed [px]
   int klt_window_px = 15;               ///< KLT window side [px]
   int klt_pyramid_levels = 3;           ///< KLT pyramid levels above the image [1]

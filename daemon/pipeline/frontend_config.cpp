@@ -89,6 +89,7 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   f.tracker.max_features = s.max_features;
   f.tracker.min_distance_px = s.min_feature_distance_px;
   f.tracker.ransac_threshold_px = s.ransac_threshold_px;
+  f.tracker.ransac_max_iterations = s.ransac_max_iterations;
   f.tracker.max_forward_backward_px = s.forward_backward_px;
   f.tracker.klt_window_px = s.klt_window_px;
   f.tracker.klt_pyramid_levels = s.klt_pyramid_levels;

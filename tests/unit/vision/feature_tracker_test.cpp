@@ -165,7 +165,7 @@ TEST(FundamentalRansac, RejectsInjectedOutliers) {
     outlier.push_back(bad);
   }
   std::vector<std::uint8_t> inlier;
-  const int count = reject_with_fundamental(a, b, 1.0, 0.99, inlier);
+  const int count = reject_with_fundamental(a, b, 1.0, 0.99, 1000, inlier);
   // The true fundamental matrix: an outlier displaced along its own epipolar line cannot be told
   // from a match, so only those off it by more than 2 px must go.
   const Eigen::Matrix3d K = camera.K();
@@ -191,14 +191,21 @@ TEST(FundamentalRansac, RejectsInjectedOutliers) {
   EXPECT_EQ(count, kept);
   // Deterministic: the same input gives the same mask.
   std::vector<std::uint8_t> again;
-  reject_with_fundamental(a, b, 1.0, 0.99, again);
+  reject_with_fundamental(a, b, 1.0, 0.99, 1000, again);
   EXPECT_EQ(again, inlier);
+  // With 80 % inliers RANSAC reaches its confidence within a few dozen draws: capped at 200 it
+  // keeps the same tracks. A single draw is a different, worse answer: the cap is honoured.
+  std::vector<std::uint8_t> capped, one_draw;
+  reject_with_fundamental(a, b, 1.0, 0.99, 200, capped);
+  EXPECT_EQ(capped, inlier);
+  reject_with_fundamental(a, b, 1.0, 0.99, 1, one_draw);
+  EXPECT_NE(one_draw, inlier);
 }
 
 TEST(FundamentalRansac, TooFewMatchesRejectNothing) {
   const std::vector<cv::Point2f> a(5, {10, 10}), b(5, {11, 10});
   std::vector<std::uint8_t> inlier;
-  EXPECT_EQ(reject_with_fundamental(a, b, 1.0, 0.99, inlier), 5);
+  EXPECT_EQ(reject_with_fundamental(a, b, 1.0, 0.99, 1000, inlier), 5);
   EXPECT_EQ(inlier, std::vector<std::uint8_t>(5, 1));
 }
 
