@@ -5,8 +5,10 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
+#include <span>
 
 #include "core/estimator/factors.hpp"
 #include "core/math/so3.hpp"
@@ -26,6 +28,16 @@ SlidingWindowConfig window_config(const LioConfig& c) {
 Eigen::Matrix<double, 6, 6> covariance_of(const Eigen::Matrix<double, 6, 6>& information) {
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   return (information + 1e-9 * Mat6::Identity()).ldlt().solve(Mat6::Identity());
+}
+
+/// The scan says nothing along `directions` (unit translations in the lidar frame, the axes of
+/// its information's translation block): that information is projected onto their complement.
+/// The rotation and the other translations keep theirs.
+void drop_translations(LidarPose& lidar, std::span<const Eigen::Vector3d> directions) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Mat6 P = Mat6::Identity();
+  for (const Eigen::Vector3d& e : directions) P.block<3, 3>(3, 3) -= e * e.transpose();
+  lidar.information = P * lidar.information * P.transpose();
 }
 
 }  // namespace
@@ -495,7 +507,6 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
 }
 
 void LioEstimator::reconcile(LidarPose& lidar) {
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
   const imu::ImuState previous = window_.latest();
   const Eigen::Matrix3d R_i = previous.q_map_imu.toRotationMatrix();
   // The lidar's position of the new state relative to the previous one, in the previous frame.
@@ -519,7 +530,8 @@ void LioEstimator::reconcile(LidarPose& lidar) {
   const Eigen::Matrix3d I_lidar_body = lidar.information.bottomRightCorner<3, 3>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(
       0.5 * (I_lidar_body + I_lidar_body.transpose()));
-  Mat6 P = Mat6::Identity();
+  std::array<Eigen::Vector3d, 3> overruled;
+  std::size_t count = 0;
   for (int k = 0; k < 3; ++k) {
     const double lambda = es.eigenvalues()(k);
     if (lambda >= config_.aided_trusted_information) continue;  // the scan pins it firmly
@@ -536,15 +548,14 @@ void LioEstimator::reconcile(LidarPose& lidar) {
     // The scan and the cameras disagree along a direction the scan pins only weakly: an
     // aliased match (a roadway's uniform pipes) more often than a camera error, since the
     // cameras' motion passed its own checks. The scan says nothing there.
-    P.block<3, 3>(3, 3) -= e_lidar * e_lidar.transpose();
+    overruled[count++] = e_lidar;
     ++figures_.lidar_directions_overruled;
   }
-  lidar.information = P * lidar.information * P.transpose();
+  drop_translations(lidar, std::span<const Eigen::Vector3d>(overruled.data(), count));
 }
 
 void LioEstimator::leave_weak_directions_to_imu(LidarPose& lidar) {
   if (config_.aided_blind_weak_ratio <= 0) return;
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
   const Eigen::Matrix3d I_t = lidar.information.bottomRightCorner<3, 3>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (I_t + I_t.transpose()));
   // Ascending: only a tube's signature, one weak translation under two firm ones. Elsewhere
@@ -553,10 +564,8 @@ void LioEstimator::leave_weak_directions_to_imu(LidarPose& lidar) {
   const Eigen::Vector3d lambda = es.eigenvalues();
   const double firm = config_.aided_blind_weak_ratio * lambda(2);
   if (lambda(0) >= firm || lambda(1) < firm) return;
-  const Eigen::Vector3d e = es.eigenvectors().col(0);
-  Mat6 P = Mat6::Identity();
-  P.block<3, 3>(3, 3) -= e * e.transpose();
-  lidar.information = P * lidar.information * P.transpose();
+  const Eigen::Vector3d weakest = es.eigenvectors().col(0);
+  drop_translations(lidar, std::span<const Eigen::Vector3d>(&weakest, 1));
   ++figures_.lidar_directions_left_to_imu;
 }
 
