@@ -12,6 +12,8 @@
 
 #include <map>
 #include <regex>
+#include <string>
+#include <vector>
 
 #include "drivers/recording/mcap_reader.hpp"
 #include "drivers/recording/ros2_messages.hpp"
@@ -50,6 +52,35 @@ double ate_m(const std::map<std::int64_t, rec::ros2::StampedPose>& estimate,
   return std::sqrt(sq / static_cast<double>(est.size()));
 }
 
+/// The numbers `pattern`'s groups capture in a summary, in order; the test fails (and each
+/// number reads -1) when the summary has no such line.
+std::vector<int> numbers_in(const std::string& summary, const std::string& pattern) {
+  const std::regex re(pattern);
+  std::smatch m;
+  if (!std::regex_search(summary, m, re)) {
+    ADD_FAILURE() << "no \"" << pattern << "\" in the summary:\n" << summary;
+    return std::vector<int>(re.mark_count(), -1);
+  }
+  std::vector<int> numbers;
+  for (std::size_t i = 1; i < m.size(); ++i) numbers.push_back(std::stoi(m[i]));
+  return numbers;
+}
+
+/// A simulated drive (`posectl sim`) and its ground truth.
+struct Drive {
+  TempDir dir;
+  std::string recording = dir.file("sim.mcap");
+  std::map<std::int64_t, rec::ros2::StampedPose> truth;
+};
+
+bool simulate(Drive& drive, const std::string& scenario, int seconds, int seed) {
+  if (!simulate_recording(drive.dir, drive.recording, scenario, seconds, seed, {}, 300s).ok) {
+    return false;
+  }
+  drive.truth = recorded_poses(drive.recording, "/posed/ground_truth", true);
+  return true;
+}
+
 struct Replay {
   std::map<std::int64_t, rec::ros2::StampedPose> poses;
   std::string summary;
@@ -69,21 +100,16 @@ Replay replay(TempDir& dir, const std::string& recording, const std::string& mod
 }
 
 TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
-  TempDir dir;
-  const std::string recording = dir.file("tunnel.mcap");
-  ASSERT_TRUE(simulate_recording(dir, recording, "tunnel", 30, 4, {}, 300s).ok);
-  const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
-  const Replay a = replay(dir, recording, "visible", "a");
-  const Replay b = replay(dir, recording, "visible", "b", false);
-  const Replay lio = replay(dir, recording, "off", "lio");
+  Drive drive;
+  ASSERT_TRUE(simulate(drive, "tunnel", 30, 4));
+  const Replay a = replay(drive.dir, drive.recording, "visible", "a");
+  const Replay b = replay(drive.dir, drive.recording, "visible", "b", false);
+  const Replay lio = replay(drive.dir, drive.recording, "off", "lio");
   ASSERT_GT(a.poses.size(), 250u);  // 10 Hz after the 2 s standing start
 
   // The camera is in the estimate, and says so.
   EXPECT_NE(a.summary.find("visible motion in the window"), std::string::npos) << a.summary;
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(a.summary, m, std::regex(R"(visible +factors +(\d+) between)")))
-      << a.summary;
-  EXPECT_GT(std::stoi(m[1]), 200);
+  EXPECT_GT(numbers_in(a.summary, R"(visible +factors +(\d+) between)")[0], 200);
   EXPECT_NE(a.summary.find("imu+lidar+visible"), std::string::npos) << a.summary;
   EXPECT_NE(a.summary.find("camera front end on a thread of its own"), std::string::npos)
       << a.summary;
@@ -97,7 +123,8 @@ TEST(CamerasEstimateReplay, TheVisibleCameraHoldsATunnelTheLidarLoses) {
     ASSERT_EQ(ia->second.q_xyzw, ib->second.q_xyzw);
   }
 
-  const double with_camera = ate_m(a.poses, truth), lidar_only = ate_m(lio.poses, truth);
+  const double with_camera = ate_m(a.poses, drive.truth);
+  const double lidar_only = ate_m(lio.poses, drive.truth);
   std::printf("tunnel seed 4, 30 s: ATE %.3f m with the visible camera, %.3f m lidar-inertial\n",
               with_camera, lidar_only);
   // Measured when written: 0.49 m against 4.96 m; 0.115 m since features that hold still are
@@ -113,35 +140,28 @@ TEST(CamerasEstimateReplay, ThroughTheSmokeTheImuCarriesTheAxisTheScansWouldHold
   // reopens after it. While it is out, the roadway's scans would hold the axis still (they pin
   // it weakly and cannot be checked); posed leaves that axis to the IMU, which carries the speed
   // the camera measured before the smoke.
-  TempDir dir;
-  const std::string recording = dir.file("smoke.mcap");
-  ASSERT_TRUE(simulate_recording(dir, recording, "smoke", 40, 4, {}, 300s).ok);
-  const auto truth = recorded_poses(recording, "/posed/ground_truth", true);
-  const Replay left = replay(dir, recording, "visible", "left");
-  const Replay held = replay(dir, recording, "visible", "held", true,
+  Drive drive;
+  ASSERT_TRUE(simulate(drive, "smoke", 40, 4));
+  const Replay left = replay(drive.dir, drive.recording, "visible", "left");
+  const Replay held = replay(drive.dir, drive.recording, "visible", "held", true,
                              "estimator:\n  camera_blind_weak_lidar_ratio: 0\n");
   ASSERT_GT(left.poses.size(), 350u);
 
-  std::smatch m;
   // The visible stream left in the smoke and came back.
-  ASSERT_TRUE(std::regex_search(
-      left.summary, m, std::regex(R"(visible +factors .*left (\d+), rejoined (\d+) times)")))
-      << left.summary;
-  EXPECT_GE(std::stoi(m[1]), 1);
-  EXPECT_GE(std::stoi(m[2]), 1);
-  ASSERT_TRUE(std::regex_search(
-      left.summary, m, std::regex(R"((\d+) left to the IMU while the cameras were blind)")))
-      << left.summary;
-  EXPECT_GT(std::stoi(m[1]), 20);
-  ASSERT_TRUE(std::regex_search(
-      held.summary, m, std::regex(R"((\d+) left to the IMU while the cameras were blind)")))
-      << held.summary;
-  EXPECT_EQ(std::stoi(m[1]), 0);
+  const std::vector<int> gate =
+      numbers_in(left.summary, R"(visible +factors .*left (\d+), rejoined (\d+) times)");
+  EXPECT_GE(gate[0], 1);
+  EXPECT_GE(gate[1], 1);
+  const std::string left_to_imu = R"((\d+) left to the IMU while the cameras were blind)";
+  EXPECT_GT(numbers_in(left.summary, left_to_imu)[0], 20);
+  EXPECT_EQ(numbers_in(held.summary, left_to_imu)[0], 0);
 
-  const double ate_left = ate_m(left.poses, truth), ate_held = ate_m(held.poses, truth);
+  const double ate_left = ate_m(left.poses, drive.truth);
+  const double ate_held = ate_m(held.poses, drive.truth);
   std::printf("smoke seed 4, 40 s: ATE %.3f m with the axis left to the IMU, %.3f m held\n",
               ate_left, ate_held);
-  // Measured when written: 0.144 m against 9.32 m.
+  // Measured when written: 0.144 m against 9.32 m; 0.150 m against 9.21 m with RANSAC capped at
+  // 200 draws (stop 51).
   EXPECT_LT(ate_left, 0.5);
   EXPECT_GT(ate_held, 4 * ate_left);
 }
