@@ -94,6 +94,24 @@ void fill(estimator::SlidingWindow& w, double t_last) {
   for (double t = 0.1; t <= t_last + 1e-9; t += 0.1) w.add(state_at(t), pre, std::nullopt);
 }
 
+/// factors_config() with a gate that closes under confidence 0.2 and reopens over 0.3.
+CameraFactorsConfig gated_config() {
+  CameraFactorsConfig c = factors_config();
+  c.min_confidence = 0.2;
+  c.rejoin_confidence = 0.3;
+  return c;
+}
+
+/// The motions `factors` give a new state at `t_state` + 0.1 s, the window filled up to `t_state`.
+std::vector<estimator::RelativeMotion> motions_after(CameraFactors& factors,
+                                                     estimator::SlidingWindow& window,
+                                                     double t_state) {
+  std::vector<estimator::RelativeMotion> motions;
+  fill(window, t_state);
+  factors.relative_motions(window, state_at(t_state + 0.1), motions);
+  return motions;
+}
+
 /// Visible frames at 15 Hz from 13 ms (none on a state's stamp) up to `frames_until_s`, a window
 /// of states up to 0.3 s, and the motions `factors` give a new state at 0.4 s.
 std::vector<estimator::RelativeMotion> one_motion(CameraFactors& factors, const FactorsWorld& world,
@@ -247,10 +265,7 @@ TEST(CameraFactors, WhereTheLidarIsStrongAFactorSaysNoMoreThanItsTranslationFloo
 
 TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {
   const FactorsWorld world;
-  CameraFactorsConfig c = factors_config();
-  c.min_confidence = 0.2;
-  c.rejoin_confidence = 0.3;
-  CameraFactors factors(c);
+  CameraFactors factors(gated_config());
   estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
   double t_frame = 0.013;
   const auto frames_until = [&](double t, double confidence) {
@@ -258,13 +273,7 @@ TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {
       factors.add_frame(vision::FrontendMode::kVisible, world.frame(t_frame, confidence));
     }
   };
-  std::vector<estimator::RelativeMotion> motions;
-  const auto step = [&](double t_state) {
-    motions.clear();
-    fill(window, t_state);
-    factors.relative_motions(window, state_at(t_state + 0.1), motions);
-    return motions.size();
-  };
+  const auto step = [&](double t_state) { return motions_after(factors, window, t_state).size(); };
   frames_until(0.45, 0.9);
   EXPECT_EQ(step(0.3), 1u);
   frames_until(0.85, 0.05);  // blinded: 6 poor frames
@@ -283,10 +292,8 @@ TEST(CameraFactors, AStreamIsGatedOutWhileItsImagesArePoorAndReturns) {
 TEST(CameraFactors, TheThermalStreamStandsByWhileTheVisibleOneSeesAndStandsInWhenItIsBlind) {
   const FactorsWorld world;
   const auto run = [&](bool standby) {
-    CameraFactorsConfig c = factors_config();
+    CameraFactorsConfig c = gated_config();
     c.streams = {true, true, false};
-    c.min_confidence = 0.2;
-    c.rejoin_confidence = 0.3;
     c.thermal_standby = standby;
     CameraFactors factors(c);
     estimator::SlidingWindow window(estimator::SlidingWindowConfig{});
@@ -302,11 +309,10 @@ TEST(CameraFactors, TheThermalStreamStandsByWhileTheVisibleOneSeesAndStandsInWhe
     };
     // The kinds of factor a new state after `t_state` gets.
     const auto kinds = [&](double t_state) {
-      std::vector<estimator::RelativeMotion> motions;
-      fill(window, t_state);
-      factors.relative_motions(window, state_at(t_state + 0.1), motions);
       std::vector<estimator::FactorKind> out;
-      for (const estimator::RelativeMotion& m : motions) out.push_back(m.kind);
+      for (const estimator::RelativeMotion& m : motions_after(factors, window, t_state)) {
+        out.push_back(m.kind);
+      }
       return out;
     };
     using K = estimator::FactorKind;
