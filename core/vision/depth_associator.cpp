@@ -134,10 +134,11 @@ void DepthAssociator::set_points(std::span<const Eigen::Vector3f> p_cam_m) {
 std::size_t DepthAssociator::nearest(const Eigen::Vector2f& key, double max_key_distance_rad,
                                      std::size_t wanted, std::uint32_t* index,
                                      float* distance_sq) const {
-  if (wanted == 0 || points_.empty()) return 0;
+  if (wanted == 0 || points_.empty() || !key.allFinite()) return 0;
   const double cell = std::max(config_.cell_rad, 1e-5);
+  // Clamped as a double first: a key far outside the grid must not overflow the int.
   const auto cell_of = [](double offset, int cells) {
-    return std::clamp(static_cast<int>(std::floor(offset)), 0, cells - 1);
+    return static_cast<int>(std::clamp(std::floor(offset), 0.0, static_cast<double>(cells - 1)));
   };
   const int qx = cell_of((key.x() - azimuth_min_) / cell, cells_x_);
   const int qy = cell_of((key.y() - elevation_min_) / cell, cells_y_);

@@ -226,6 +226,13 @@ TEST(DepthAssociator, TheRingSearchFindsExactlyTheNearestKeysABruteForceSearchFi
     ++compared;
     if (found < wanted) ++short_of_wanted;
   }
+  // A key far outside the grid still finds the nearest points; a NaN key finds none.
+  ASSERT_EQ(depth.nearest(Eigen::Vector2f(1e9f, -1e9f), std::numeric_limits<double>::infinity(), 3,
+                          index.data(), distance_sq.data()),
+            3u);
+  EXPECT_EQ(
+      depth.nearest(Eigen::Vector2f(std::nanf(""), 0.f), 1.0, 3, index.data(), distance_sq.data()),
+      0u);
   EXPECT_EQ(compared, 2000);
   EXPECT_GT(short_of_wanted, 100);  // the radius limited some searches
   EXPECT_LT(short_of_wanted, 1900);
