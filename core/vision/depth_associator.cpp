@@ -73,6 +73,8 @@ DepthAssociator::DepthAssociator(const DepthConfig& config, const PinholeCamera&
   const double widest = std::sqrt(1.0 + std::max(x_min_ * x_min_, x_max_ * x_max_));
   y_min_ = std::tan(elevation_min_) * (elevation_min_ < 0 ? widest : 1.0);
   y_max_ = std::tan(elevation_max_) * (elevation_max_ > 0 ? widest : 1.0);
+  cos_elevation_bound_ = std::cos(std::max(std::abs(elevation_min_), std::abs(elevation_max_)));
+  sin_half_neighbour_angle_ = std::sin(config_.max_neighbour_angle_rad / 2);
   const double cell = std::max(config_.cell_rad, 1e-5);
   cells_x_ = std::max(1, static_cast<int>(std::ceil((azimuth_max_ - azimuth_min_) / cell)));
   cells_y_ = std::max(1, static_cast<int>(std::ceil((elevation_max_ - elevation_min_) / cell)));
@@ -211,9 +213,8 @@ DepthResult DepthAssociator::depth(const Eigen::Vector2d& normalised) const {
   // sin(d / 2) (haversine, and sin(u) / u falling on [0, pi/2]): beyond that radius every
   // point is further than the allowed angle.
   const double cos_elevations =
-      std::sqrt(std::cos(std::max(std::abs(elevation_min_), std::abs(elevation_max_))) *
-                std::cos(std::abs(static_cast<double>(key.y()))));
-  const double sin_half = std::sin(config_.max_neighbour_angle_rad / 2) / cos_elevations;
+      std::sqrt(cos_elevation_bound_ * std::cos(std::abs(static_cast<double>(key.y()))));
+  const double sin_half = sin_half_neighbour_angle_ / cos_elevations;
   const double radius = sin_half < 1.0 ? 2 * std::asin(sin_half) * (1 + 1e-4) + 1e-6
                                        : std::numeric_limits<double>::infinity();
   const std::size_t found = nearest(key, radius, wanted, index.data(), distance_sq.data());

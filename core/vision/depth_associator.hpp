@@ -104,6 +104,8 @@ class DepthAssociator {
   double azimuth_min_ = 0, azimuth_max_ = 0, elevation_min_ = 0, elevation_max_ = 0;
   // Normalised-plane bounds for the cheap first cull (before any trigonometry).
   double x_min_ = 0, x_max_ = 0, y_min_ = 0, y_max_ = 0;
+  // depth()'s search radius: cos of the grid's largest |elevation|, sin(max_neighbour_angle / 2)
+  double cos_elevation_bound_ = 1, sin_half_neighbour_angle_ = 0;
   int cells_x_ = 0, cells_y_ = 0;
   // per polar cell: index into candidates_ while thinning, then into points_; -1 = empty
   std::vector<std::int32_t> cell_best_;
