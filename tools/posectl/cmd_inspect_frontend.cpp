@@ -84,13 +84,14 @@ void print_table(const std::vector<const CameraFigures*>& columns,
     return percent(static_cast<double>(c.depth_total), static_cast<double>(c.features_total));
   });
   if (truth != nullptr) {
-    const auto stats = [truth](const CameraFigures& c) {
+    const auto mode_of = [](const CameraFigures& c) {
       vision::FrontendMode mode = vision::FrontendMode::kFused;
       for (const vision::FrontendMode m : kModes) {
         if (vision::to_string(m) == c.mode) mode = m;
       }
-      return truth->stats(mode);
+      return mode;
     };
+    const auto stats = [&](const CameraFigures& c) { return truth->stats(mode_of(c)); };
     row("lidar depth error vs truth, median [m]", [&](const CameraFigures& c) {
       const DepthErrorStats s = stats(c);
       return s.features > 0 ? number(s.median_abs_m, "%.3f") : std::string("-");
@@ -106,6 +107,34 @@ void print_table(const std::vector<const CameraFigures*>& columns,
     row("lidar depth within 10 % of truth [%]", [&](const CameraFigures& c) {
       const DepthErrorStats s = stats(c);
       return s.features > 0 ? number(100.0 * s.within_10_percent, "%.1f") : std::string("-");
+    });
+    const auto tracks = [&](const CameraFigures& c) { return truth->track_stats(mode_of(c)); };
+    // Track steps whose world point moved >= 2 px under the true motion (frontend_depth_truth.hpp)
+    row("track steps judged vs truth [1]", [&](const CameraFigures& c) {
+      const TrackTruthStats s = tracks(c);
+      return s.steps > 0 ? number(static_cast<double>(s.steps), "%.0f") : std::string("-");
+    });
+    row("track error vs truth, median [px]", [&](const CameraFigures& c) {
+      const TrackTruthStats s = tracks(c);
+      return s.steps > 0 ? number(s.median_error_px, "%.2f") : std::string("-");
+    });
+    row("tracks following the world [%]", [&](const CameraFigures& c) {
+      const TrackTruthStats s = tracks(c);
+      return s.steps > 0 ? number(100.0 * s.with_world, "%.1f") : std::string("-");
+    });
+    row("tracks held still [%]", [&](const CameraFigures& c) {
+      const TrackTruthStats s = tracks(c);
+      return s.steps > 0 ? number(100.0 * s.held_still, "%.1f") : std::string("-");
+    });
+    row("verified tracks following the world [%]", [&](const CameraFigures& c) {
+      const TrackTruthStats s = tracks(c);
+      return s.verified_steps > 0 ? number(100.0 * s.verified_with_world, "%.1f")
+                                  : std::string("-");
+    });
+    row("verified tracks held still [%]", [&](const CameraFigures& c) {
+      const TrackTruthStats s = tracks(c);
+      return s.verified_steps > 0 ? number(100.0 * s.verified_held_still, "%.1f")
+                                  : std::string("-");
     });
   }
   const char* quality_names[3] = {"mean confidence, visible [0..1]",

@@ -81,6 +81,7 @@ std::unique_ptr<FrontendDepthTruth> FrontendDepthTruth::for_recording(
   truth->world_->bvh = std::make_unique<sim::Bvh>(truth->world_->scenario.world);
   truth->world_->host_epoch_ns = static_cast<std::int64_t>(epoch_ns);
   truth->world_->T_base_cam = pipeline::to_isometry(config.extrinsics.T_imu_cam);
+  truth->focal_px_ = config.visible_camera.fx;
   truth->world_->T_base_thermal_origin =
       truth->world_->T_base_cam *
       Eigen::Translation3d(pipeline::to_isometry(config.extrinsics.T_cam_thermal).translation());
@@ -102,11 +103,18 @@ void FrontendDepthTruth::on_frame(const vision::FrontendFrame& frame,
       (frame.mode == vision::FrontendMode::kThermal ? world_->T_base_thermal_origin
                                                     : world_->T_base_cam);
   const Eigen::Isometry3d T_cam_map = T_map_cam.inverse();
+  std::unordered_map<std::uint64_t, LastSeen> seen_now;
+  seen_now.reserve(frame.features.size());
   for (const vision::FrontendFeature& f : frame.features) {
-    if (std::isnan(f.depth_m)) continue;
     const Eigen::Vector3d d_cam = Eigen::Vector3d(f.normalised.x(), f.normalised.y(), 1.0);
     const Eigen::Vector3d dir = (T_map_cam.linear() * d_cam).normalized();
     const std::optional<sim::RayHit> hit = world_->bvh->cast(T_map_cam.translation(), dir, 200.0);
+    if (const auto last = last_seen_[m].find(f.id); last != last_seen_[m].end()) {
+      add_track_step(m, f, last->second, T_cam_map);
+    }
+    if (hit)
+      seen_now.emplace(f.id, LastSeen{f.normalised, T_map_cam.translation() + hit->t_m * dir});
+    if (std::isnan(f.depth_m)) continue;
     if (!hit) {
       ++missed_[m];
       continue;
@@ -117,6 +125,50 @@ void FrontendDepthTruth::on_frame(const vision::FrontendFrame& frame,
     relative_errors_[m].push_back(error / z_true);
     signed_relative_errors_[m].push_back((f.depth_m - z_true) / z_true);
   }
+  last_seen_[m] = std::move(seen_now);
+}
+
+void FrontendDepthTruth::add_track_step(std::size_t m, const vision::FrontendFeature& f,
+                                        const LastSeen& last, const Eigen::Isometry3d& T_cam_map) {
+  const Eigen::Vector3d p_cam = T_cam_map * last.p_map_m;
+  if (p_cam.z() <= 1e-3) return;  // behind the camera now: nothing to judge
+  const Eigen::Vector2d n_true = p_cam.head<2>() / p_cam.z();
+  const Eigen::Vector2d true_flow_px = (n_true - last.normalised) * focal_px_;
+  const double true_flow = true_flow_px.norm();
+  if (true_flow < kMinTrueFlowPx) return;
+  const Eigen::Vector2d seen_flow_px = (f.normalised - last.normalised) * focal_px_;
+  const double error_px = (seen_flow_px - true_flow_px).norm();
+  const double along = seen_flow_px.dot(true_flow_px) / (true_flow * true_flow);
+  track_steps_[m].push_back({static_cast<float>(error_px),
+                             error_px <= std::max(1.0, 0.2 * true_flow), along < 0.3, f.verified});
+}
+
+TrackTruthStats FrontendDepthTruth::track_stats(vision::FrontendMode mode) const {
+  const std::vector<TrackStep>& steps = track_steps_[static_cast<std::size_t>(mode)];
+  TrackTruthStats s;
+  s.steps = steps.size();
+  if (steps.empty()) return s;
+  std::vector<double> errors;
+  errors.reserve(steps.size());
+  std::uint64_t with_world = 0, still = 0, v_with_world = 0, v_still = 0;
+  for (const TrackStep& step : steps) {
+    errors.push_back(step.error_px);
+    with_world += step.with_world ? 1 : 0;
+    still += step.held_still ? 1 : 0;
+    if (!step.verified) continue;
+    ++s.verified_steps;
+    v_with_world += step.with_world ? 1 : 0;
+    v_still += step.held_still ? 1 : 0;
+  }
+  const auto share = [](std::uint64_t k, std::uint64_t n) {
+    return n == 0 ? 0.0 : static_cast<double>(k) / static_cast<double>(n);
+  };
+  s.median_error_px = quantile(std::move(errors), 0.5);
+  s.with_world = share(with_world, s.steps);
+  s.held_still = share(still, s.steps);
+  s.verified_with_world = share(v_with_world, s.verified_steps);
+  s.verified_held_still = share(v_still, s.verified_steps);
+  return s;
 }
 
 DepthErrorStats FrontendDepthTruth::stats(vision::FrontendMode mode) const {
