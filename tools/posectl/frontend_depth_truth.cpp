@@ -112,14 +112,14 @@ void FrontendDepthTruth::on_frame(const vision::FrontendFrame& frame,
     if (const auto last = last_seen_[m].find(f.id); last != last_seen_[m].end()) {
       add_track_step(m, f, last->second, T_cam_map);
     }
-    if (hit)
-      seen_now.emplace(f.id, LastSeen{f.normalised, T_map_cam.translation() + hit->t_m * dir});
-    if (std::isnan(f.depth_m)) continue;
     if (!hit) {
-      ++missed_[m];
+      missed_[m] += std::isnan(f.depth_m) ? 0 : 1;
       continue;
     }
-    const double z_true = (T_cam_map * (T_map_cam.translation() + hit->t_m * dir)).z();
+    const Eigen::Vector3d p_map = T_map_cam.translation() + hit->t_m * dir;
+    seen_now.emplace(f.id, LastSeen{f.normalised, p_map});
+    if (std::isnan(f.depth_m)) continue;
+    const double z_true = (T_cam_map * p_map).z();
     const double error = std::abs(f.depth_m - z_true);
     abs_errors_m_[m].push_back(error);
     relative_errors_[m].push_back(error / z_true);
