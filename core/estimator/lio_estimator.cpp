@@ -11,6 +11,7 @@
 #include <span>
 
 #include "core/estimator/factors.hpp"
+#include "core/estimator/match_retry.hpp"
 #include "core/math/so3.hpp"
 
 namespace posed::estimator {
@@ -370,7 +371,8 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
 
   // A match far from the prediction is more likely a wrong basin than the truth. When it is the
   // IMU's prediction that led nowhere (a faulty or saturated IMU), the lidar alone may still
-  // know: retry from its constant-velocity prediction, deskewed with that motion.
+  // know: retry from its constant-velocity prediction, deskewed with that motion, and judge what
+  // the retry says (match_retry.hpp).
   bool imu_suspect = false;
   std::optional<Eigen::Vector3d> lidar_velocity;
   if (!window_.empty() && !plausible(match, T_pred)) {
@@ -379,8 +381,10 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
       lidar_.deskew(point_span, scan.start_stamp, cv->motion);
       lidar_.extract_features();
       lidar::ScanMatchResult retry = lidar_.match(cv->T_map_lidar);
-      if (plausible(retry, cv->T_map_lidar)) {
-        match = retry;
+      const MatchRetryVerdict verdict = judge_match_retry(
+          plausible(retry, cv->T_map_lidar), plausible(retry, T_pred), retry.degenerate_directions);
+      if (verdict != MatchRetryVerdict::kReject) match = retry;
+      if (verdict == MatchRetryVerdict::kImuSuspect) {
         imu_suspect = true;
         lidar_velocity = cv->v_map_mps;
       }
