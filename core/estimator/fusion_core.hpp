@@ -131,7 +131,10 @@ struct FusionFigures {
   std::uint64_t scans_degenerate = 0;   ///< matches with a degenerate direction [1]
   std::uint64_t scans_skipped = 0;      ///< scans before alignment or without IMU coverage [1]
   std::uint64_t reinitialisations = 0;  ///< divergences detected and restarted from [1]
-  std::uint64_t keyframes = 0;          ///< scans added to the map as keyframes [1]
+  /// why the window last restarted (a string literal; empty before any)
+  const char* last_reinitialisation_reason = "";
+  HostTime last_reinitialisation_stamp;  ///< the scan it restarted at
+  std::uint64_t keyframes = 0;           ///< scans added to the map as keyframes [1]
   /// translation directions where a scan's weak information was dropped for disagreeing with
   /// the cameras [1]
   std::uint64_t lidar_directions_overruled = 0;

@@ -249,15 +249,25 @@ void LioEstimator::reanchor_propagation(const imu::ImuState& state) {
   propagated_last_ = previous;
 }
 
-bool LioEstimator::diverged(const imu::ImuState& s) const {
-  return s.v_map_mps.norm() > config_.max_speed_mps ||
-         s.bias.gyro_radps.norm() > config_.max_gyro_bias_radps ||
-         s.bias.accel_mps2.norm() > config_.max_accel_bias_mps2 || !s.p_map_imu_m.allFinite() ||
-         !s.q_map_imu.coeffs().allFinite();
+const char* LioEstimator::divergence(const imu::ImuState& s) const {
+  if (!s.p_map_imu_m.allFinite() || !s.q_map_imu.coeffs().allFinite()) {
+    return "the state is not finite";
+  }
+  if (s.v_map_mps.norm() > config_.max_speed_mps) return "speed beyond estimator.max_speed_mps";
+  if (s.bias.gyro_radps.norm() > config_.max_gyro_bias_radps) {
+    return "gyro bias beyond estimator.max_gyro_bias_radps";
+  }
+  if (s.bias.accel_mps2.norm() > config_.max_accel_bias_mps2) {
+    return "accelerometer bias beyond estimator.max_accel_bias_mps2";
+  }
+  return nullptr;
 }
 
-void LioEstimator::reinitialise(const imu::ImuState& at, const Eigen::Vector3d& v_map_mps) {
+void LioEstimator::reinitialise(const imu::ImuState& at, const Eigen::Vector3d& v_map_mps,
+                                const char* reason) {
   ++figures_.reinitialisations;
+  figures_.last_reinitialisation_reason = reason;
+  figures_.last_reinitialisation_stamp = at.stamp;
   mode_ = EstimatorMode::kReinitialising;
   imu::ImuState s = at;
   s.v_map_mps = v_map_mps;
@@ -419,7 +429,9 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     window_.reset(predicted, sigma);
   } else if (imu_suspect) {
     // The IMU contradicts the lidar: its preintegration cannot join the window.
-    reinitialise(imu_state_at(match.T_map_lidar, t), *lidar_velocity);
+    reinitialise(imu_state_at(match.T_map_lidar, t), *lidar_velocity,
+                 "the scan matched from the lidar's own motion pins every direction and is far "
+                 "from the IMU's prediction: the IMU is distrusted");
   } else {
     add_to_window(predicted, integrated.pre, match);
   }
@@ -428,15 +440,15 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
     mode_ = match.ok && match.degenerate_directions > 0 ? EstimatorMode::kDegenerate
                                                         : EstimatorMode::kLidarInertial;
   }
-  if (diverged(estimate)) {
+  if (const char* why = divergence(estimate)) {
     // Restart from the lidar's pose: this scan's when it matched, else where the lidar's own
     // motion says; only without either from where the IMU says.
     if (match.ok) {
-      reinitialise(imu_state_at(match.T_map_lidar, t), lidar_velocity_or_zero(t));
+      reinitialise(imu_state_at(match.T_map_lidar, t), lidar_velocity_or_zero(t), why);
     } else if (const auto cv = constant_velocity(t)) {
-      reinitialise(imu_state_at(cv->T_map_lidar, t), cv->v_map_mps);
+      reinitialise(imu_state_at(cv->T_map_lidar, t), cv->v_map_mps, why);
     } else {
-      reinitialise(predicted, Eigen::Vector3d::Zero());
+      reinitialise(predicted, Eigen::Vector3d::Zero(), why);
     }
     estimate = window_.latest();
   }

@@ -166,9 +166,11 @@ class LioEstimator final : public FusionCore {
   void reanchor_propagation(const imu::ImuState& state);
   NavState to_nav_state(const imu::ImuState& s, const Eigen::Vector3d& w_body, bool optimised,
                         const Eigen::Matrix<double, 6, 6>& cov_tangent) const;
-  bool diverged(const imu::ImuState& s) const;
   /// Restarts the window at `at` (pose) with `v_map_mps` and the start-up biases; counted.
-  void reinitialise(const imu::ImuState& at, const Eigen::Vector3d& v_map_mps);
+  /// `reason`: a string literal for the figures (and so the log).
+  void reinitialise(const imu::ImuState& at, const Eigen::Vector3d& v_map_mps, const char* reason);
+  /// Why `s` diverged, or null if it did not.
+  const char* divergence(const imu::ImuState& s) const;
   /// A match close enough to the prediction to be believed.
   bool plausible(const lidar::ScanMatchResult& match, const Eigen::Isometry3d& T_predicted) const;
   /// The lidar's own prediction for `t`: the last two matched poses' twist held (no IMU).

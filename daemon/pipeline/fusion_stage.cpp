@@ -189,6 +189,16 @@ void FusionStage::note_imu_switch() {
   }
 }
 
+void FusionStage::note_reinitialisation() {
+  const FusionFigures f = core_->figures();
+  if (f.reinitialisations == reinitialisations_logged_) return;
+  reinitialisations_logged_ = f.reinitialisations;
+  POSED_LOG_WARN("estimator: the window restarted at %.3f s (%llu so far): %s",
+                 f.last_reinitialisation_stamp.seconds(),
+                 static_cast<unsigned long long>(f.reinitialisations),
+                 f.last_reinitialisation_reason);
+}
+
 void FusionStage::run() {
   apply_thread_policy("posed-fusion", config_.threads.fusion);
   Lane<ImuItem> imu(inputs_.imu);
@@ -266,6 +276,7 @@ void FusionStage::run() {
           ScanItem item = scans.take();
           took(1, item);
           core_->add_scan(std::move(item.scan), produced_);
+          note_reinitialisation();
           ++scans_handed_;
           tag_new_states();
           counters_.scans_fused.fetch_add(1, std::memory_order_relaxed);

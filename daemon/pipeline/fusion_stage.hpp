@@ -114,6 +114,8 @@ class FusionStage {
   void hand_image(Lane<ImageItem>& lane, CameraStream stream);
   /// Logs and counts a hand-over between the A9 and the D435i's IMU.
   void note_imu_switch();
+  /// Logs a restart of the estimator's window since the last scan, with its reason.
+  void note_reinitialisation();
   /// Routes the states the core produced: to the publisher and, as anchors, to the odometry.
   void route_states();
   void emit_states();
@@ -131,6 +133,7 @@ class FusionStage {
   std::vector<ScanObserver*> scan_observers_;
   /// scans handed to the core so far [1]
   std::uint64_t scans_handed_ = 0;
+  std::uint64_t reinitialisations_logged_ = 0;  // the estimator's restarts said so far
   /// per state in produced_ / outgoing_: scans_handed_ when the core made it
   std::vector<std::uint64_t> produced_scans_before_;
   std::vector<std::uint64_t> outgoing_scans_before_;

@@ -6,6 +6,7 @@
 #include <Eigen/SVD>
 #include <cstdio>
 #include <optional>
+#include <string>
 
 #include "core/estimator/lio_estimator.hpp"
 #include "core/math/so3.hpp"
@@ -160,6 +161,11 @@ TEST(LioEstimator, DivergenceIsDetectedAndTheEstimateRecovers) {
     if (t > 15.0 && t < 16.5) s.specific_force_mps2.x() = 80.0;
   });
   EXPECT_GE(o.figures.reinitialisations, 1u);
+  // The restart says when and why (the daemon logs it).
+  EXPECT_GT(std::string(o.figures.last_reinitialisation_reason).size(), 10u);
+  const double restarted_s = (o.figures.last_reinitialisation_stamp - t0).seconds();
+  EXPECT_GT(restarted_s, 15.0);
+  EXPECT_LT(restarted_s, 18.0);
   // After the fault the lidar and the restarted window bring it back: the last 5 s are good.
   std::vector<Eigen::Vector3d> est, gt;
   for (const NavState& s : o.poses) {
