@@ -96,7 +96,8 @@ void CameraFactors::add_frame(vision::FrontendMode mode, const vision::FrontendF
   for (const vision::FrontendFeature& feature : frame.features) {
     // Only features known to move with the world (not fixed to the camera) give its motion.
     if (!feature.verified || feature.track_length < config_.min_track_length) continue;
-    stored.features.push_back({feature.id, feature.normalised, feature.depth_m});
+    stored.features.push_back(
+        {feature.id, feature.normalised, feature.depth_m, feature.patch_shape});
   }
   s.frames.push_back(std::move(stored));
 }

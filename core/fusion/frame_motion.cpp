@@ -19,7 +19,27 @@ struct Observation {
   Eigen::Vector3d X;  ///< in the frame that gave the depth [m]
   Eigen::Vector2d u;  ///< normalised coordinates in the other frame [-]
   bool forward;       ///< X in a, observed in b
+  /// L with LᵀL the observation's information relative to pixel_sigma (aperture_max_ratio);
+  /// identity: isotropic
+  Eigen::Matrix2d L = Eigen::Matrix2d::Identity();
 };
+
+/// The whitening of an observation seen through patches of shapes `a` and `b` (each 1 along its
+/// best direction), each direction's sigma at most `max_ratio` times the best.
+Eigen::Matrix2d aperture_whitening(const Eigen::Matrix2d& a, const Eigen::Matrix2d& b,
+                                   double max_ratio) {
+  const auto covariance = [max_ratio](const Eigen::Matrix2d& shape) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (shape + shape.transpose()));
+    const Eigen::Vector2d floored =
+        es.eigenvalues().cwiseMax(1.0 / (max_ratio * max_ratio)).cwiseMin(1.0);
+    return Eigen::Matrix2d(es.eigenvectors() * floored.cwiseInverse().asDiagonal() *
+                           es.eigenvectors().transpose());
+  };
+  // The flow is the difference of two tracked positions: their covariances add. Two corners
+  // give 2 I, which the factor 2 takes back to the isotropic weight.
+  const Eigen::Matrix2d W = 2.0 * (covariance(a) + covariance(b)).inverse();
+  return Eigen::Matrix2d(Eigen::LLT<Eigen::Matrix2d>(W).matrixU());
+}
 
 /// Residual π(X') - u of one observation under T_a_b = (R, p), and its Jacobian in the right
 /// perturbation (φ, ρ). False when the point is not in front of the observing camera.
@@ -45,6 +65,13 @@ bool residual(const Observation& o, const Eigen::Matrix3d& R, const Eigen::Vecto
   return true;
 }
 
+/// r and J in the observation's own metric (Observation::L); untouched when isotropic.
+void whiten(const Observation& o, Eigen::Vector2d& r, Mat26& J) {
+  if (o.L.isIdentity(0)) return;
+  r = o.L * r;
+  J = o.L * J;
+}
+
 }  // namespace
 
 FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<const FrameFeature> b,
@@ -59,11 +86,15 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
     } else if (b[j].id < a[i].id) {
       ++j;
     } else {
+      const Eigen::Matrix2d L =
+          config.aperture_max_ratio > 1
+              ? aperture_whitening(a[i].patch_shape, b[j].patch_shape, config.aperture_max_ratio)
+              : Eigen::Matrix2d::Identity();
       if (usable(a[i].depth_m)) {
-        obs.push_back({a[i].depth_m * a[i].normalised.homogeneous(), b[j].normalised, true});
+        obs.push_back({a[i].depth_m * a[i].normalised.homogeneous(), b[j].normalised, true, L});
       }
       if (usable(b[j].depth_m)) {
-        obs.push_back({b[j].depth_m * b[j].normalised.homogeneous(), a[i].normalised, false});
+        obs.push_back({b[j].depth_m * b[j].normalised.homogeneous(), a[i].normalised, false, L});
       }
       ++i;
       ++j;
@@ -122,6 +153,7 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
       Vec6 g = Vec6::Zero();
       for (std::size_t k = 0; k < obs.size(); ++k) {
         if (inlier[k] == 0 || !residual(obs[k], R, p, config.min_depth_m, r, J)) continue;
+        whiten(obs[k], r, J);
         const double e = r.norm() / config.pixel_sigma;
         const double w = e <= config.huber_sigma ? 1.0 : config.huber_sigma / e;
         H += w * info * J.transpose() * J;
@@ -141,7 +173,7 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
     if (round == 0) {
       for (std::size_t k = 0; k < obs.size(); ++k) {
         if (!residual(obs[k], R, p, config.min_depth_m, r, J) ||
-            r.norm() > config.outlier_sigma * config.pixel_sigma) {
+            (whiten(obs[k], r, J), r.norm() > config.outlier_sigma * config.pixel_sigma)) {
           inlier[k] = 0;
         }
       }
@@ -152,6 +184,7 @@ FrameMotion estimate_frame_motion(std::span<const FrameFeature> a, std::span<con
   double sum_sq = 0;
   for (std::size_t k = 0; k < obs.size(); ++k) {
     if (inlier[k] == 0 || !residual(obs[k], R, p, config.min_depth_m, r, J)) continue;
+    whiten(obs[k], r, J);
     H += info * J.transpose() * J;
     sum_sq += r.squaredNorm() * info;
     ++out.inliers;

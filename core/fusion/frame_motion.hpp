@@ -27,6 +27,9 @@ struct FrameFeature {
   std::uint64_t id = 0;
   Eigen::Vector2d normalised = Eigen::Vector2d::Zero();  ///< (x/z, y/z) in the camera frame [-]
   double depth_m = std::numeric_limits<double>::quiet_NaN();  ///< z; NaN: no lidar depth [m]
+  /// how well its image patch fixes it per direction, 1 along the best (vision::FrontendFeature::
+  /// patch_shape) [-]
+  Eigen::Matrix2d patch_shape = Eigen::Matrix2d::Identity();
 };
 
 struct FrameMotionConfig {
@@ -61,6 +64,12 @@ struct FrameMotionConfig {
   /// needs, so a feature of the world passes it; if most observations fail it, the guess is what
   /// is wrong (a speed estimate twice the truth) and none is left out.
   double still_flow_sigma = 2.0;
+  /// Weigh each observation by its features' patch shapes, its sigma along a direction the
+  /// patches fix poorly up to this many times pixel_sigma (0 or 1: every observation isotropic).
+  /// Along a straight edge KLT cannot see motion (the aperture problem); in a corridor the
+  /// walls' and floor's edges run towards the focus of expansion, along the flow, so their tracks
+  /// slide or stick along them and, weighed as corners, pull the motion short.
+  double aperture_max_ratio = 0;
 };
 
 enum class FrameMotionStatus : std::uint8_t {

@@ -49,6 +49,12 @@ struct FrontendFeature {
   /// change of `normalised` since the previous frame over the stamp difference [1/s]; zero for
   /// a new feature
   Eigen::Vector2d velocity_per_s = Eigen::Vector2d::Zero();
+  /// How well the feature's image patch fixes its position in each direction: the patch's
+  /// structure tensor (the sum of gradient outer products over the KLT window, in pixel axes)
+  /// over its largest eigenvalue, so 1 along the best-fixed direction. A corner is near the
+  /// identity; a patch on a straight edge is near 0 along the edge, where KLT cannot see motion
+  /// (the aperture problem) and its track slides or sticks. Identity where not computed [-]
+  Eigen::Matrix2d patch_shape = Eigen::Matrix2d::Identity();
   /// its image has moved as a point of the world would (fusion::StaticTrackFilter); until then
   /// it may be fixed to the camera and does not enter the estimate
   bool verified = false;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/vision/image_view.hpp"
+#include "core/vision/patch_shape.hpp"
 
 namespace posed::vision {
 
@@ -245,6 +246,7 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     f.pixel_px = {t.pixel.x, t.pixel.y};
     f.normalised = t.normalised;
     f.track_length = t.length;
+    f.patch_shape = patch_shape(tracked, t.pixel, config_.tracker.klt_window_px / 2);
     if (lidar) {
       const DepthResult d = depth_.depth(t.normalised);
       f.depth_m = d.depth_m;

@@ -466,6 +466,11 @@ const Field kSchema[] = {
     F("estimator.camera_still_flow_sigma", estimator.camera_still_flow_sigma, "2", "", 0, 100, "",
       "a feature nearer to where it was than to where the predicted motion moves it, by more than "
       "this many pixel sigmas, is left out (a corner of the lamp's shading or lens dirt); 0: off"),
+    F("estimator.camera_aperture_max_ratio", estimator.camera_aperture_max_ratio, "0", "", 0, 1000,
+      "",
+      "a tracked feature weighs in its frame pair's motion by its image patch's structure: along "
+      "a direction the patch fixes poorly (a straight edge, where KLT slides) its sigma grows up "
+      "to this many times the pixel sigma; 0 or 1: every feature as a corner"),
     F("estimator.camera_degeneracy_translation_threshold",
       estimator.camera_degeneracy_translation_threshold, "10", "", 0, 10000, "",
       "while a camera stream is in the estimate, a scan is degenerate along translations it pins "

@@ -261,7 +261,8 @@ struct EstimatorSection {
   double camera_landmark_outlier_sigma = 15;  ///< landmarks the solve leaves further off go [sigma]
   double camera_landmark_huber_sigma = 3;     ///< Huber threshold of their factors [sigma]
   double camera_still_flow_sigma = 2;         ///< features that hold still are left out [sigma]
-  double camera_guess_gate_px = 3;            ///< features further from the prediction: out [px]
+  double camera_aperture_max_ratio = 0;  ///< edges' sigma along themselves up to this; 0: off [1]
+  double camera_guess_gate_px = 3;       ///< features further from the prediction: out [px]
   double camera_weak_lidar_guess_gate_px = 6;           ///< the same near a degenerate scan [px]
   bool pose_selection = true;                           ///< seed 001's adaptive initial value
   double camera_degeneracy_translation_threshold = 10;  ///< with cameras in the estimate [1]

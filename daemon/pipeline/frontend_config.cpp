@@ -162,6 +162,7 @@ fusion::CameraFactorsConfig camera_factors_config(const config::PosedConfig& con
   c.floor_rotation_rad = e.camera_floor_rotation_deg * M_PI / 180.0;
   c.keyframe_states = std::min(e.camera_keyframe_states, std::max(e.window_size - 1, 1));
   c.motion.still_flow_sigma = e.camera_still_flow_sigma;
+  c.motion.aperture_max_ratio = e.camera_aperture_max_ratio;
   c.guess_gate_px = e.camera_guess_gate_px;
   c.weak_lidar_guess_gate_px = e.camera_weak_lidar_guess_gate_px;
   c.coupling = e.camera_coupling == "landmarks"         ? fusion::CameraCoupling::kLandmarks
