@@ -218,7 +218,7 @@ bool print_run_summary(const RunSummary& r) {
     std::printf(
         "  scan matching       %llu used, %llu rejected, %llu degenerate, %llu skipped; %llu "
         "keyframes; %llu re-initialisations; %llu weak directions overruled by the cameras, %llu "
-        "left to the IMU while the cameras were blind\n",
+        "left to the IMU while the cameras were blind; %llu states held to the vehicle's motion\n",
         static_cast<unsigned long long>(f.scans_used),
         static_cast<unsigned long long>(f.scans_rejected),
         static_cast<unsigned long long>(f.scans_degenerate),
@@ -226,7 +226,8 @@ bool print_run_summary(const RunSummary& r) {
         static_cast<unsigned long long>(f.keyframes),
         static_cast<unsigned long long>(f.reinitialisations),
         static_cast<unsigned long long>(f.lidar_directions_overruled),
-        static_cast<unsigned long long>(f.lidar_directions_left_to_imu));
+        static_cast<unsigned long long>(f.lidar_directions_left_to_imu),
+        static_cast<unsigned long long>(f.vehicle_motion_states));
     std::printf("  IMU biases          gyro [%.5f %.5f %.5f] rad/s, accel [%.4f %.4f %.4f] m/s^2\n",
                 f.gyro_bias_radps.x(), f.gyro_bias_radps.y(), f.gyro_bias_radps.z(),
                 f.accel_bias_mps2.x(), f.accel_bias_mps2.y(), f.accel_bias_mps2.z());

@@ -169,6 +169,38 @@ bool LidarPoseFactor::Evaluate(double const* const* parameters, double* residual
   return true;
 }
 
+VehicleMotionFactor::VehicleMotionFactor(const Eigen::Vector3d& w_base_radps,
+                                         const Eigen::Vector3d& c_base_m, double sigma_lateral_mps,
+                                         double sigma_vertical_mps)
+    : w_cross_c_(w_base_radps.cross(c_base_m)),
+      inv_sigma_(1.0 / sigma_lateral_mps, 1.0 / sigma_vertical_mps) {}
+
+bool VehicleMotionFactor::Evaluate(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  const Mat3 R =
+      Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized().toRotationMatrix();
+  const Eigen::Map<const Eigen::Vector3d> v(parameters[1]);
+  const Eigen::Vector3d v_body = R.transpose() * v;
+  const Eigen::Vector3d v_c = v_body + w_cross_c_;
+  residuals[0] = v_c.y() * inv_sigma_.x();
+  residuals[1] = v_c.z() * inv_sigma_.y();
+  if (jacobians == nullptr) return true;
+  const Eigen::Matrix<double, 2, 3> S =
+      inv_sigma_.asDiagonal() * Eigen::Matrix3d::Identity().bottomRows<2>();
+  if (jacobians[0] != nullptr) {
+    // R Exp(dθ): Rᵀ v -> (I - [dθ]x) Rᵀ v = Rᵀ v + [Rᵀ v]x dθ.
+    Eigen::Matrix<double, 2, 6> J = Eigen::Matrix<double, 2, 6>::Zero();
+    J.rightCols<3>() = S * skew(v_body);
+    pose_jacobian<2>(J, parameters[0], jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 9, Eigen::RowMajor>> J(jacobians[1]);
+    J.setZero();
+    J.leftCols<3>() = S * R.transpose();
+  }
+  return true;
+}
+
 RelativePoseFactor::RelativePoseFactor(const Eigen::Isometry3d& T_i_j,
                                        const Eigen::Matrix<double, 6, 6>& information)
     : R_meas_(T_i_j.linear()),

@@ -102,6 +102,26 @@ class LandmarkFactor final : public ceres::SizedCostFunction<2, 7, 7> {
   double sqrt_information_;
 };
 
+/// A wheeled or tracked vehicle's motion: the point of the body that rolls without slipping
+/// (`c_base_m`, the middle of a differential drive's axle) moves along the body's x, neither
+/// sideways nor up. 2 residuals [y, z] of that point's velocity in base_link, v_c = Rᵀ v + ω × c,
+/// over `sigma_mps` (wheel slip, bumps, a slope's change). ω (body, gyro less its bias at the
+/// state) is a constant of the factor. Blocks: the state's pose (7) and speed_bias (9).
+/// Along a corridor or a roadway, where the lidar pins the motion across the axis but not along
+/// it, this ties the speed along the axis to the pinned sideways speed whenever the heading is
+/// off the axis (a swerve, a U-turn): v_x = v_y / tan(heading).
+class VehicleMotionFactor final : public ceres::SizedCostFunction<2, 7, 9> {
+ public:
+  VehicleMotionFactor(const Eigen::Vector3d& w_base_radps, const Eigen::Vector3d& c_base_m,
+                      double sigma_lateral_mps, double sigma_vertical_mps);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Vector3d w_cross_c_;  // ω × c [m/s]
+  Eigen::Vector2d inv_sigma_;
+};
+
 /// The square root of a (possibly singular) information matrix: S with Sᵀ S = information.
 Eigen::Matrix<double, 6, 6> sqrt_information(const Eigen::Matrix<double, 6, 6>& information);
 

@@ -141,6 +141,8 @@ struct FusionFigures {
   /// translation directions a scan pinned weakly where the cameras, blind, could not check
   /// them: left to the IMU [1]
   std::uint64_t lidar_directions_left_to_imu = 0;
+  /// states held to a wheeled vehicle's motion (estimator.vehicle_motion) [1]
+  std::uint64_t vehicle_motion_states = 0;
   int degenerate_directions = 0;                              ///< in the last scan's match [1]
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  ///< current estimate [rad/s]
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();  ///< current estimate [m/s^2]

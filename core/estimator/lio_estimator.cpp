@@ -478,6 +478,27 @@ void LioEstimator::process_scan(const Bundle<LidarScan>& bundle, std::vector<Nav
   states.push_back(s);
 }
 
+Eigen::Vector3d LioEstimator::body_rate(const imu::ImuState& state) const {
+  if (bundle_imu_.empty()) return Eigen::Vector3d::Zero();
+  return bundle_imu_.back().angular_velocity_radps - state.bias.gyro_radps;
+}
+
+bool LioEstimator::vehicle_motion_applies(const imu::ImuState& state) const {
+  switch (config_.vehicle_motion) {
+    case LioConfig::VehicleMotion::kOff:
+      return false;
+    case LioConfig::VehicleMotion::kEveryState:
+      return true;
+    case LioConfig::VehicleMotion::kWhereBlind:
+      break;
+  }
+  if (!lidar_suspect_ || !motions_.empty()) return false;
+  // The turn rate about the map's vertical, in the body.
+  const Eigen::Vector3d up_base =
+      state.q_map_imu.normalized().conjugate() * Eigen::Vector3d::UnitZ();
+  return std::abs(body_rate(state).dot(up_base)) >= config_.vehicle_min_yaw_rate_radps;
+}
+
 void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Preintegration& pre,
                                  const lidar::ScanMatchResult& match) {
   std::uint8_t modalities = kModalityImu;
@@ -503,6 +524,15 @@ void LioEstimator::add_to_window(const imu::ImuState& predicted, const imu::Prei
   from_ids_.clear();
   for (const RelativeMotion& m : motions_) from_ids_.push_back(window_.id(m.from_index));
   window_.add(initial, pre, lidar_factor);
+  if (vehicle_motion_applies(initial)) {
+    window_.add_factor(
+        FactorKind::kVehicleMotion,
+        std::make_unique<VehicleMotionFactor>(body_rate(initial), config_.vehicle_centre_m,
+                                              config_.vehicle_lateral_sigma_mps,
+                                              config_.vehicle_vertical_sigma_mps),
+        {{window_.latest_id(), BlockRole::kPose}, {window_.latest_id(), BlockRole::kSpeedBias}});
+    ++figures_.vehicle_motion_states;
+  }
   for (std::size_t k = 0; k < motions_.size(); ++k) {
     const RelativeMotion& m = motions_[k];
     std::unique_ptr<ceres::LossFunction> loss;

@@ -49,6 +49,18 @@ struct LioConfig {
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
   lidar::LidarOdometryConfig lidar;
   SlidingWindowConfig window;  ///< gravity and T_imu_lidar are copied in from above
+  /// A wheeled or tracked vehicle's motion (VehicleMotionFactor): the point `vehicle_centre_m`
+  /// of base_link moves along base_link's x only, to these sigmas. kWhereBlind: only on states
+  /// where nothing else pins the speed along the lidar's weak direction (the lidar weak, no
+  /// camera motion for the state) and the vehicle turns at `vehicle_min_yaw_rate_radps` or more:
+  /// where its heading leaves the axis, the sideways speed the lidar pins gives the speed along
+  /// it. Off for a handheld or legged rig.
+  enum class VehicleMotion : std::uint8_t { kOff, kEveryState, kWhereBlind };
+  VehicleMotion vehicle_motion = VehicleMotion::kOff;
+  double vehicle_min_yaw_rate_radps = 0;                       ///< kWhereBlind [rad/s]
+  double vehicle_lateral_sigma_mps = 0.05;                     ///< [m/s]
+  double vehicle_vertical_sigma_mps = 0.05;                    ///< [m/s]
+  Eigen::Vector3d vehicle_centre_m = Eigen::Vector3d::Zero();  ///< in base_link [m]
   // Divergence limits: beyond any of them the estimate is not trusted.
   double max_speed_mps = 40.0;       ///< [m/s]
   double max_gyro_bias_radps = 0.3;  ///< [rad/s]
@@ -151,6 +163,11 @@ class LioEstimator final : public FusionCore {
   /// from the initial value the pose selection chose; the window is solved.
   void add_to_window(const imu::ImuState& predicted, const imu::Preintegration& pre,
                      const lidar::ScanMatchResult& match);
+  /// The body's angular rate at the newest IMU sample, less `state`'s gyro bias [rad/s].
+  Eigen::Vector3d body_rate(const imu::ImuState& state) const;
+  /// Whether `state`, about to join the window, takes a VehicleMotionFactor (config's
+  /// vehicle_motion); needs this scan's motions_ and lidar_suspect_.
+  bool vehicle_motion_applies(const imu::ImuState& state) const;
   /// Drops the scan's information along weakly pinned translations where it disagrees with the
   /// aiding's motions for this interval (see aided_trusted_information).
   void reconcile(LidarPose& lidar);

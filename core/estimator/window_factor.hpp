@@ -21,16 +21,17 @@ namespace posed::estimator {
 
 /// What a factor measures; for the status and the counters, the window treats all alike.
 enum class FactorKind : std::uint8_t {
-  kPrior,      ///< the start-up prior or what marginalisation left behind
-  kImu,        ///< preintegrated IMU between consecutive states
-  kLidarPose,  ///< a scan-to-map pose of the lidar on one state
-  kVisible,    ///< relative motion of the visible camera between two states
-  kThermal,    ///< relative motion of the thermal camera between two states
-  kFused,      ///< relative motion from the DWT-fused visible+thermal image between two states
+  kPrior,          ///< the start-up prior or what marginalisation left behind
+  kImu,            ///< preintegrated IMU between consecutive states
+  kLidarPose,      ///< a scan-to-map pose of the lidar on one state
+  kVisible,        ///< relative motion of the visible camera between two states
+  kThermal,        ///< relative motion of the thermal camera between two states
+  kFused,          ///< relative motion from the DWT-fused visible+thermal image between two states
+  kVehicleMotion,  ///< a wheeled vehicle's velocity along its body x (VehicleMotionFactor)
 };
-inline constexpr std::size_t kFactorKinds = 6;
+inline constexpr std::size_t kFactorKinds = 7;
 inline constexpr std::array<std::string_view, kFactorKinds> kFactorKindNames = {
-    "prior", "imu", "lidar_pose", "visible", "thermal", "fused"};
+    "prior", "imu", "lidar_pose", "visible", "thermal", "fused", "vehicle_motion"};
 constexpr std::string_view to_string(FactorKind k) {
   return kFactorKindNames[static_cast<std::size_t>(k)];
 }

@@ -365,6 +365,24 @@ const Field kSchema[] = {
       "degenerate, a tilt and an accelerometer bias look the same (0: estimated from the start)"),
     F("estimator.solver_iterations", estimator.solver_iterations, "8", "", 1, 100, "",
       "Levenberg-Marquardt iterations of the window per scan"),
+    F("estimator.vehicle_motion", estimator.vehicle_motion, "off", "", 0, 0, "off|always|blind",
+      "a wheeled or tracked vehicle: the point vehicle_centre_* of base_link moves along "
+      "base_link's x only (no sideways or vertical speed). always: on every state; blind: only "
+      "where the lidar is weak, no camera gave the state a motion and the vehicle turns at "
+      "vehicle_min_yaw_rate_dps or more, where the sideways speed the lidar pins gives the speed "
+      "along a corridor's or a roadway's axis. off for a handheld or legged rig"),
+    F("estimator.vehicle_min_yaw_rate_dps", estimator.vehicle_min_yaw_rate_dps, "0", "deg/s", 0,
+      1000, "", "with vehicle_motion: blind, only on states turning at least this fast"),
+    F("estimator.vehicle_lateral_sigma_mps", estimator.vehicle_lateral_sigma_mps, "0.05", "m/s",
+      0.001, 10, "", "sideways speed of the vehicle's no-slip point, 1 sigma (wheel slip)"),
+    F("estimator.vehicle_vertical_sigma_mps", estimator.vehicle_vertical_sigma_mps, "0.05", "m/s",
+      0.001, 10, "", "its vertical speed, 1 sigma (bumps, a slope's change)"),
+    F("estimator.vehicle_centre_x_m", estimator.vehicle_centre_x_m, "0", "m", -10, 10, "",
+      "the vehicle's no-slip point in base_link (a differential drive's axle middle): x"),
+    F("estimator.vehicle_centre_y_m", estimator.vehicle_centre_y_m, "0", "m", -10, 10, "",
+      "and its y"),
+    F("estimator.vehicle_centre_z_m", estimator.vehicle_centre_z_m, "0", "m", -10, 10, "",
+      "and its z"),
     F("estimator.max_speed_mps", estimator.max_speed_mps, "40", "m/s", 1, 200, "",
       "an estimated speed above this is a divergence (re-initialise)"),
     F("estimator.max_gyro_bias_radps", estimator.max_gyro_bias_radps, "0.3", "rad/s", 0.001, 10, "",

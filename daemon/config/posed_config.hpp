@@ -224,10 +224,17 @@ struct EstimatorSection {
   double gravity_tilt_prior_deg = 1.0;  ///< its prior at a (re)start, 1 sigma per axis [deg]
   /// held until the heading has spanned this much [deg]
   double gravity_tilt_release_heading_deg = 45.0;
-  int solver_iterations = 8;         ///< Levenberg-Marquardt iterations per scan [1]
-  double max_speed_mps = 40;         ///< faster means diverged [m/s]
-  double max_gyro_bias_radps = 0.3;  ///< larger means diverged [rad/s]
-  double max_accel_bias_mps2 = 2.0;  ///< larger means diverged [m/s^2]
+  int solver_iterations = 8;                 ///< Levenberg-Marquardt iterations per scan [1]
+  std::string vehicle_motion = "off";        ///< off | always | blind
+  double vehicle_min_yaw_rate_dps = 0;       ///< blind: only while turning this fast [deg/s]
+  double vehicle_lateral_sigma_mps = 0.05;   ///< [m/s]
+  double vehicle_vertical_sigma_mps = 0.05;  ///< [m/s]
+  double vehicle_centre_x_m = 0;             ///< the no-slip point in base_link [m]
+  double vehicle_centre_y_m = 0;             ///< [m]
+  double vehicle_centre_z_m = 0;             ///< [m]
+  double max_speed_mps = 40;                 ///< faster means diverged [m/s]
+  double max_gyro_bias_radps = 0.3;          ///< larger means diverged [rad/s]
+  double max_accel_bias_mps2 = 2.0;          ///< larger means diverged [m/s^2]
   double max_match_jump_m = 1.0;     ///< a scan match further from the IMU prediction is refused
   double max_match_jump_deg = 11.5;  ///< [deg]
   bool degeneracy_handling = true;   ///< remap degenerate directions to the IMU prediction

@@ -55,6 +55,14 @@ estimator::LioConfig lio_config(const config::PosedConfig& c) {
   l.window.estimate_gravity_tilt = e.estimate_gravity_tilt;
   l.window.gravity_tilt_prior_rad = e.gravity_tilt_prior_deg * kDeg;
   l.window.gravity_tilt_release_yaw_rad = e.gravity_tilt_release_heading_deg * kDeg;
+  l.vehicle_motion = e.vehicle_motion == "always" ? estimator::LioConfig::VehicleMotion::kEveryState
+                     : e.vehicle_motion == "blind"
+                         ? estimator::LioConfig::VehicleMotion::kWhereBlind
+                         : estimator::LioConfig::VehicleMotion::kOff;
+  l.vehicle_min_yaw_rate_radps = e.vehicle_min_yaw_rate_dps * M_PI / 180.0;
+  l.vehicle_lateral_sigma_mps = e.vehicle_lateral_sigma_mps;
+  l.vehicle_vertical_sigma_mps = e.vehicle_vertical_sigma_mps;
+  l.vehicle_centre_m = {e.vehicle_centre_x_m, e.vehicle_centre_y_m, e.vehicle_centre_z_m};
   l.max_speed_mps = e.max_speed_mps;
   l.max_gyro_bias_radps = e.max_gyro_bias_radps;
   l.max_accel_bias_mps2 = e.max_accel_bias_mps2;

@@ -183,6 +183,54 @@ TEST(Factors, RelativePoseFactorJacobiansMatchNumericDifferentiation) {
   expect_jacobians_match(results, 1e-6);
 }
 
+TEST(Factors, VehicleMotionFactorJacobiansMatchNumericDifferentiation) {
+  // Turning and driving with a sideways and vertical slip, about a no-slip point behind the IMU.
+  const VehicleMotionFactor factor(Eigen::Vector3d(0.05, -0.02, 0.4),
+                                   Eigen::Vector3d(-0.3, 0.05, -0.2), 0.05, 0.08);
+  imu::ImuState s;
+  s.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.12, -0.18, 0.45)));
+  s.p_map_imu_m = Eigen::Vector3d(3.1, -2.2, 0.4);
+  s.v_map_mps = Eigen::Vector3d(1.1, 0.7, 0.05);
+  s.bias.gyro_radps = {0.01, -0.02, 0.005};
+  s.bias.accel_mps2 = {0.05, 0.02, -0.04};
+  double pose[7], sb[9];
+  state_arrays(s, pose, sb);
+  const double* params[] = {pose, sb};
+  PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr};
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, 1e-6, &results);
+  expect_jacobians_match(results, 1e-6);
+}
+
+TEST(Factors, VehicleMotionFactorIsZeroForAVehicleDrivingAlongItsXAndLargeForSideways) {
+  // Yawed by 0.6 rad and driving along its x at 2 m/s, turning at 0.5 rad/s about its own point.
+  imu::ImuState s;
+  s.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0, 0, 0.6)));
+  s.v_map_mps = s.q_map_imu * Eigen::Vector3d(2.0, 0, 0);
+  double pose[7], sb[9];
+  state_arrays(s, pose, sb);
+  const double* params[] = {pose, sb};
+  double r[2];
+  const VehicleMotionFactor at_imu(Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d::Zero(), 0.05, 0.05);
+  ASSERT_TRUE(at_imu.Evaluate(params, r, nullptr));
+  EXPECT_NEAR(r[0], 0.0, 1e-12);
+  EXPECT_NEAR(r[1], 0.0, 1e-12);
+  // The same motion judged about a no-slip point 0.4 m behind the IMU: the IMU then swings
+  // sideways at 0.5 * 0.4 = 0.2 m/s, which that point does not: 4 sigma.
+  const VehicleMotionFactor behind(Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d(-0.4, 0, 0), 0.05,
+                                   0.05);
+  ASSERT_TRUE(behind.Evaluate(params, r, nullptr));
+  EXPECT_NEAR(r[0], -4.0, 1e-9);
+  // Driving sideways at 0.1 m/s: 2 sigma.
+  s.v_map_mps = s.q_map_imu * Eigen::Vector3d(2.0, 0.1, 0);
+  state_arrays(s, pose, sb);
+  ASSERT_TRUE(at_imu.Evaluate(params, r, nullptr));
+  EXPECT_NEAR(r[0], 2.0, 1e-9);
+}
+
 TEST(Factors, LandmarkFactorJacobiansMatchNumericDifferentiation) {
   Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
   T_body_cam.linear() = so3::exp(Eigen::Vector3d(-1.5, 0.05, -1.55));  // looking ahead, z forward

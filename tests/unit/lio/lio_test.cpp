@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SVD>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -271,6 +272,41 @@ TEST(LioEstimator, WhileTheCamerasAreBlindTheScansWeaklyPinnedTranslationsAreLef
   const Outcome alone = run_lio(run, config, 0.0, [](ImuSample&) {});
   EXPECT_EQ(alone.figures.lidar_directions_left_to_imu, 0u);
   EXPECT_EQ(alone.ate_rmse_m, held.ate_rmse_m);
+}
+
+TEST(LioEstimator, AVehicleMotionHoldsOnlyTheStatesNothingElsePinsWhileTurning) {
+  // The tunnel's scans pin its axis weakly and the cameras are blind: with vehicle_motion
+  // "blind" the states that turn at the configured rate take the vehicle's motion, the others
+  // not; on the street, where the lidar pins everything, none does.
+  const sim::LidarImuRun& tunnel = test::simulated("tunnel", 30.0, 4);
+  BlindAiding blind;
+  LioConfig config = lio_config(tunnel.rig);
+  const auto run_with = [&](LioConfig::VehicleMotion mode, double min_yaw_rate_dps) {
+    config.vehicle_motion = mode;
+    config.vehicle_min_yaw_rate_radps = min_yaw_rate_dps * M_PI / 180.0;
+    return run_lio(
+        tunnel, config, 0.0, [](ImuSample&) {}, &blind);
+  };
+  const Outcome off = run_with(LioConfig::VehicleMotion::kOff, 0);
+  const Outcome every = run_with(LioConfig::VehicleMotion::kEveryState, 0);
+  const Outcome blind_any = run_with(LioConfig::VehicleMotion::kWhereBlind, 0);
+  const Outcome blind_turning = run_with(LioConfig::VehicleMotion::kWhereBlind, 1);
+  EXPECT_EQ(off.figures.vehicle_motion_states, 0u);
+  // Every state that joined the window (one per scan used, the first ones aligning).
+  EXPECT_GE(every.figures.vehicle_motion_states + 10, every.figures.scans_used);
+  EXPECT_LE(every.figures.vehicle_motion_states, every.figures.scans_used);
+  // Where the lidar has shown itself weak: most of the tunnel's states, not all.
+  EXPECT_GT(blind_any.figures.vehicle_motion_states, 100u);
+  EXPECT_LT(blind_any.figures.vehicle_motion_states, every.figures.vehicle_motion_states);
+  // Of those, the ones turning at 1 deg/s or more: fewer, on the tunnel's gentle swerves.
+  EXPECT_LT(blind_turning.figures.vehicle_motion_states, blind_any.figures.vehicle_motion_states);
+  EXPECT_NE(every.ate_rmse_m, off.ate_rmse_m);  // the factor acts on the estimate
+  const sim::LidarImuRun& street = test::simulated("street_night", 30.0, 4);
+  LioConfig street_config = lio_config(street.rig);
+  street_config.vehicle_motion = LioConfig::VehicleMotion::kWhereBlind;
+  const Outcome open = run_lio(
+      street, street_config, 0.0, [](ImuSample&) {}, &blind);
+  EXPECT_EQ(open.figures.vehicle_motion_states, 0u);
 }
 
 }  // namespace
