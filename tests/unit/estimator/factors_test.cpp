@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/estimator/pose_manifold.hpp"
 #include "tests/unit/estimator/analytic_motion.hpp"
@@ -54,6 +55,32 @@ void expect_jacobians_match(const ceres::GradientChecker::ProbeResults& r, doubl
   }
 }
 
+/// Probes `factor` at `params` with ceres' GradientChecker (the pose blocks, where `is_pose`
+/// says, on PoseManifold; `relative_step` its numeric step) and expects analytic and numeric
+/// Jacobians to match to `tol`.
+void expect_jacobians_match(const ceres::CostFunction& factor, double const* const* params,
+                            const std::vector<bool>& is_pose, double relative_step, double tol) {
+  PoseManifold pose_manifold;
+  std::vector<const ceres::Manifold*> manifolds;
+  for (const bool pose : is_pose) manifolds.push_back(pose ? &pose_manifold : nullptr);
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(&factor, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(params, relative_step, &results);
+  expect_jacobians_match(results, tol);
+}
+
+/// A state turning, tilted and moving, with biases: where the factors' Jacobians are checked.
+imu::ImuState moving_state() {
+  imu::ImuState s;
+  s.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.12, -0.18, 0.45)));
+  s.p_map_imu_m = Eigen::Vector3d(3.1, -2.2, 0.4);
+  s.v_map_mps = Eigen::Vector3d(1.1, 0.7, 0.05);
+  s.bias.gyro_radps = {0.01, -0.02, 0.005};
+  s.bias.accel_mps2 = {0.05, 0.02, -0.04};
+  return s;
+}
+
 /// The motion's IMU samples from 1.0 to 1.2 s, preintegrated about biases away from zero.
 imu::Preintegration preintegrated_from_1_to_1_2_s(const test::AnalyticMotion& m) {
   imu::ImuBias lin;
@@ -82,14 +109,7 @@ TEST(Factors, ImuFactorJacobiansMatchNumericDifferentiation) {
   state_arrays(j, pose_j, sb_j);
   const double* params[] = {pose_i, sb_i, pose_j, sb_j};
 
-  PoseManifold pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, &pose_manifold,
-                                                         nullptr};
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&factor, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params, 1e-5, &results);
-  expect_jacobians_match(results, 1e-5);
+  expect_jacobians_match(factor, params, {true, false, true, false}, 1e-5, 1e-5);
 }
 
 TEST(Factors, ImuFactorWithTheMapsTiltJacobiansMatchNumericDifferentiation) {
@@ -110,14 +130,7 @@ TEST(Factors, ImuFactorWithTheMapsTiltJacobiansMatchNumericDifferentiation) {
   state_arrays(j, pose_j, sb_j);
   double tilt[2] = {0.012, -0.02};
   const double* params[] = {pose_i, sb_i, pose_j, sb_j, tilt};
-  PoseManifold pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, &pose_manifold,
-                                                         nullptr, nullptr};
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&factor, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params, 1e-5, &results);
-  expect_jacobians_match(results, 1e-5);
+  expect_jacobians_match(factor, params, {true, false, true, false, false}, 1e-5, 1e-5);
 
   // At zero tilt it is the plain factor.
   const ImuFactor plain(pre, m.gravity_mps2);
@@ -149,13 +162,7 @@ TEST(Factors, LidarPoseFactorJacobiansMatchNumericDifferentiation) {
   double pose[7], sb[9];
   state_arrays(s, pose, sb);
   const double* params[] = {pose};
-  PoseManifold pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold};
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&factor, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params, 1e-6, &results);
-  expect_jacobians_match(results, 1e-6);
+  expect_jacobians_match(factor, params, {true}, 1e-6, 1e-6);
 }
 
 TEST(Factors, RelativePoseFactorJacobiansMatchNumericDifferentiation) {
@@ -174,35 +181,18 @@ TEST(Factors, RelativePoseFactorJacobiansMatchNumericDifferentiation) {
   state_arrays(i, pose_i, sb);
   state_arrays(j, pose_j, sb);
   const double* params[] = {pose_i, pose_j};
-  PoseManifold pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, &pose_manifold};
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&factor, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params, 1e-6, &results);
-  expect_jacobians_match(results, 1e-6);
+  expect_jacobians_match(factor, params, {true, true}, 1e-6, 1e-6);
 }
 
 TEST(Factors, VehicleMotionFactorJacobiansMatchNumericDifferentiation) {
   // Turning and driving with a sideways and vertical slip, about a no-slip point behind the IMU.
   const VehicleMotionFactor factor(Eigen::Vector3d(0.05, -0.02, 0.4),
                                    Eigen::Vector3d(-0.3, 0.05, -0.2), 0.05, 0.08);
-  imu::ImuState s;
-  s.q_map_imu = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0.12, -0.18, 0.45)));
-  s.p_map_imu_m = Eigen::Vector3d(3.1, -2.2, 0.4);
-  s.v_map_mps = Eigen::Vector3d(1.1, 0.7, 0.05);
-  s.bias.gyro_radps = {0.01, -0.02, 0.005};
-  s.bias.accel_mps2 = {0.05, 0.02, -0.04};
+  const imu::ImuState s = moving_state();
   double pose[7], sb[9];
   state_arrays(s, pose, sb);
   const double* params[] = {pose, sb};
-  PoseManifold pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr};
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&factor, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params, 1e-6, &results);
-  expect_jacobians_match(results, 1e-6);
+  expect_jacobians_match(factor, params, {true, false}, 1e-6, 1e-6);
 }
 
 TEST(Factors, VehicleMotionFactorIsZeroForAVehicleDrivingAlongItsXAndLargeForSideways) {
@@ -249,13 +239,7 @@ TEST(Factors, LandmarkFactorJacobiansMatchNumericDifferentiation) {
   const double* params[] = {pose_a, pose_j};
   ASSERT_TRUE(factor.Evaluate(params, r, nullptr));
   EXPECT_GT(std::hypot(r[0], r[1]), 1.0);  // away from the measurement: every term counts
-  PoseManifold pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, &pose_manifold};
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&factor, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params, 1e-6, &results);
-  expect_jacobians_match(results, 1e-5);
+  expect_jacobians_match(factor, params, {true, true}, 1e-6, 1e-5);
 }
 
 TEST(Factors, LandmarkFactorIsZeroWhereThePointProjectsOntoItsObservation) {
