@@ -246,7 +246,9 @@ FrontendStatus VisualFrontend::process(const FrontendInput& input, FrontendFrame
     f.pixel_px = {t.pixel.x, t.pixel.y};
     f.normalised = t.normalised;
     f.track_length = t.length;
-    f.patch_shape = patch_shape(tracked, t.pixel, config_.tracker.klt_window_px / 2);
+    if (config_.patch_shapes) {
+      f.patch_shape = patch_shape(tracked, t.pixel, config_.tracker.klt_window_px / 2);
+    }
     if (lidar) {
       const DepthResult d = depth_.depth(t.normalised);
       f.depth_m = d.depth_m;

@@ -51,6 +51,9 @@ struct FrontendConfig {
   QualityConfig quality;
   TrackerConfig tracker;
   bool lines = false;  ///< LSD line features (seed 001); several ms per frame
+  /// FrontendFeature::patch_shape for every feature (the back end's aperture weighting needs
+  /// it); otherwise each is left the identity
+  bool patch_shapes = false;
   LineConfig line;
   DepthConfig depth;
   /// Depth from the D435i's depth image for the features the lidar gives none

@@ -126,6 +126,8 @@ fusion::CameraFrontEndConfig camera_front_end_config(const config::PosedConfig& 
   f.stereo_depth.max_span_m = d.feature_max_span_m;
   f.stereo_depth.min_range_m = d.feature_min_range_m;
   f.stereo_depth.max_range_m = d.feature_max_range_m;
+  // Only the aperture weighting reads the patches' shapes: not worked out per feature otherwise.
+  f.patch_shapes = config.estimator.camera_aperture_max_ratio > 1;
   return c;
 }
 
