@@ -26,7 +26,9 @@ struct MapKeyframe {
 };
 
 struct KeyframeMap {
-  double voxel_m = 0.3;            ///< the keyframe clouds' resolution [m]
+  double voxel_m = 0.3;  ///< the keyframe clouds' resolution [m]
+  /// the keyframe clouds' reach: no point farther from its keyframe (a query is cut the same) [m]
+  double max_range_m = 60.0;
   ScanContextConfig scan_context;  ///< how the descriptors were made (a query must match it)
   std::vector<MapKeyframe> keyframes;
   std::vector<PoseGraphEdge> edges;  ///< odometry and loop edges between keyframe indices

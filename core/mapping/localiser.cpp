@@ -57,9 +57,8 @@ void Localiser::add_scan(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
     if (!selector_.take(T_odom_base)) {
       return;
     }
-    const DescribedScan scan =
-        describe_scan(points_base, T_odom_base.rotation(), config_.keyframe_max_range_m,
-                      map_.voxel_m, map_.scan_context);
+    const DescribedScan scan = describe_scan(points_base, T_odom_base.rotation(), map_.max_range_m,
+                                             max_range_m(), map_.voxel_m, map_.scan_context);
     ++figures_.track_attempts;
     if (const std::optional<Fix> fix = fix_near(scan, T_odom_base, T_map_odom_ * T_odom_base)) {
       take(*fix, stamp, T_odom_base);
@@ -74,7 +73,7 @@ void Localiser::add_scan(HostTime stamp, const Eigen::Isometry3d& T_odom_base,
     return;
   }
   look_up(stamp, T_odom_base,
-          describe_scan(points_base, T_odom_base.rotation(), config_.keyframe_max_range_m,
+          describe_scan(points_base, T_odom_base.rotation(), map_.max_range_m, max_range_m(),
                         map_.voxel_m, map_.scan_context));
 }
 
@@ -188,11 +187,16 @@ std::optional<Localiser::Fix> Localiser::register_onto(
     std::span<const std::size_t> keyframes, const Eigen::Isometry3d& T_first_query_guess) {
   const MapKeyframe& first = map_.keyframes[keyframes.front()];
   const Eigen::Isometry3d T_first_map = first.T_map_base.inverse();
+  // The target is cut as the query is: a map keyframe's far points, seen from another place
+  // than the query's, add more of the map's own error than they pin.
+  const auto range2 = static_cast<float>(max_range_m() * max_range_m());
   std::vector<Eigen::Vector3f> target;
   for (const std::size_t i : keyframes) {
     const Eigen::Isometry3f T_first_i = (T_first_map * map_.keyframes[i].T_map_base).cast<float>();
     for (const Eigen::Vector3f& p : map_.keyframes[i].points_base) {
-      target.push_back(T_first_i * p);
+      if (p.squaredNorm() <= range2) {
+        target.push_back(T_first_i * p);
+      }
     }
   }
   const auto started = std::chrono::steady_clock::now();

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -32,10 +33,11 @@
 namespace posed::mapping {
 
 struct LocalisationConfig {
-  double keyframe_distance_m = 2.0;    ///< localised: a fix is attempted after moving this far [m]
-  double keyframe_angle_rad = 0.35;    ///< or turning this much [rad]
-  double keyframe_max_range_m = 60.0;  ///< points farther are not used [m]
-  int align_every_scans = 1;           ///< aligning or lost: a lookup every n-th scan [1]
+  double keyframe_distance_m = 2.0;  ///< localised: a fix is attempted after moving this far [m]
+  double keyframe_angle_rad = 0.35;  ///< or turning this much [rad]
+  /// a scan's points farther than this (or than the map's clouds reach) are not used [m]
+  double max_range_m = 60.0;
+  int align_every_scans = 1;  ///< aligning or lost: a lookup every n-th scan [1]
   /// tracking and initial poses: map keyframes within this of the predicted pose are the target
   /// [m]
   double track_radius_m = 12.0;
@@ -98,6 +100,8 @@ class Localiser {
                                              std::optional<std::size_t> exclude = {}) const;
   /// Registers the scan onto the map keyframes near `T_map_query_guess`; nullopt when none is
   /// near or the registration is refused.
+  /// How far a scan is used: the configured range, at most the map clouds' own.
+  double max_range_m() const { return std::min(config_.max_range_m, map_.max_range_m); }
   std::optional<Fix> fix_near(const DescribedScan& scan, const Eigen::Isometry3d& T_odom_query,
                               const Eigen::Isometry3d& T_map_query_guess);
   /// Registers the scan onto the map keyframe its descriptor matches best.

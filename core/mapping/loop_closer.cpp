@@ -39,7 +39,7 @@ void LoopCloser::add_keyframe(HostTime stamp, const Eigen::Isometry3d& T_odom_ba
                               double degenerate_share) {
   DescribedScan described =
       describe_scan(points_base, T_odom_base.rotation(), config_.keyframe_max_range_m,
-                    config_.keyframe_voxel_m, config_.scan_context);
+                    config_.keyframe_max_range_m, config_.keyframe_voxel_m, config_.scan_context);
   Keyframe kf;
   kf.stamp = stamp;
   kf.T_odom_base = T_odom_base;
@@ -309,6 +309,7 @@ void LoopCloser::accept(const PoseGraphEdge& edge, const LoopRecord& record) {
 KeyframeMap LoopCloser::snapshot() const {
   KeyframeMap map;
   map.voxel_m = config_.keyframe_voxel_m;
+  map.max_range_m = config_.keyframe_max_range_m;
   map.scan_context = config_.scan_context;
   map.keyframes.reserve(keyframes_.size());
   for (std::size_t i = 0; i < keyframes_.size(); ++i) {

@@ -31,10 +31,10 @@
 namespace posed::mapping {
 
 struct LoopClosureConfig {
-  double keyframe_distance_m = 1.0;    ///< a new keyframe after moving this far [m]
-  double keyframe_angle_rad = 0.35;    ///< or turning this much [rad]
-  double keyframe_voxel_m = 0.3;       ///< a keyframe's cloud is kept at this resolution [m]
-  double keyframe_max_range_m = 60.0;  ///< points farther are not kept [m]
+  double keyframe_distance_m = 1.0;     ///< a new keyframe after moving this far [m]
+  double keyframe_angle_rad = 0.35;     ///< or turning this much [rad]
+  double keyframe_voxel_m = 0.3;        ///< a keyframe's cloud is kept at this resolution [m]
+  double keyframe_max_range_m = 120.0;  ///< points farther are not kept [m]
   /// A keyframe this near an older one that keeps its cloud keeps only its pose and edges (no
   /// cloud, no descriptor) once its loop attempt is done, while a loop accepted within the last
   /// mapped_trust_keyframes keyframes vouches that the graph has this place where the older

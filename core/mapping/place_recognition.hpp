@@ -29,10 +29,11 @@ struct DescribedScan {
 };
 
 /// `points_base`: a deskewed scan in base_link; `R_world_base`: its attitude (only roll and pitch
-/// matter).
+/// matter). The descriptor is made of the points within `context_range_m` (as the map's were:
+/// a query must match them), the cloud of those within `cloud_range_m`.
 DescribedScan describe_scan(std::span<const Eigen::Vector3f> points_base,
-                            const Eigen::Matrix3d& R_world_base, double max_range_m, double voxel_m,
-                            const ScanContextConfig& config);
+                            const Eigen::Matrix3d& R_world_base, double context_range_m,
+                            double cloud_range_m, double voxel_m, const ScanContextConfig& config);
 
 struct DescriptorMatch {
   std::size_t index = 0;  ///< of the matching keyframe [1]

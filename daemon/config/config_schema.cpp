@@ -679,6 +679,11 @@ const Field kSchema[] = {
       "", "look for a loop at every n-th keyframe (registration is the expensive part)"),
     F("mapping.keyframe_voxel_m", mapping.keyframe_voxel_m, "0.3", "m", 0.05, 5, "",
       "keyframe clouds are kept thinned to one point per voxel of this size"),
+    F("mapping.keyframe_max_range_m", mapping.keyframe_max_range_m, "120", "m", 5, 130, "",
+      "keyframe clouds keep the points this near the sensor (a map keeps it; localising cuts "
+      "scans the same): far structure pins a registration where nothing stands near"),
+    F("mapping.scan_context_max_range_m", mapping.scan_context_max_range_m, "80", "m", 5, 130, "",
+      "Scan Context descriptors cover this range (in 20 rings; a map keeps it)"),
     F("mapping.max_rms_m", mapping.max_rms_m, "0.1", "m", 0.01, 2, "",
       "a loop's registration must fit to this RMS point-to-plane distance"),
     F("mapping.min_overlap", mapping.min_overlap, "0.5", "", 0, 1, "",
@@ -708,6 +713,9 @@ const Field kSchema[] = {
     F("mapping.localise_every_m", mapping.localise_every_m, "2", "m", 0.1, 100, "",
       "localising on a prior map (posed --map): once localised, register the scan onto the map "
       "after moving this far"),
+    F("mapping.localise_max_range_m", mapping.localise_max_range_m, "60", "m", 5, 130, "",
+      "localising: a scan's points this near the sensor are registered onto the map (at most "
+      "the map's own keyframe range)"),
     F("mapping.lost_after_m", mapping.lost_after_m, "25", "m", 1, 10000, "",
       "localising: travel without a verified registration after which the state is lost and the "
       "place is looked up again"),

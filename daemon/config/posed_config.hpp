@@ -324,6 +324,8 @@ struct MappingSection {
   double scan_context_max_distance = 0.25;  ///< candidates by descriptor at most this distance
   int attempt_every_keyframes = 2;          ///< loops are looked for at every n-th keyframe [1]
   double keyframe_voxel_m = 0.3;            ///< keyframe clouds kept at this resolution [m]
+  double keyframe_max_range_m = 120;        ///< and to this range [m]
+  double scan_context_max_range_m = 80;     ///< descriptors reach this far [m]
   double max_rms_m = 0.1;                   ///< a verified loop's point-to-plane RMS at most [m]
   double min_overlap = 0.5;                 ///< and its overlap at least [0..1]
   double min_constraint = 0.02;  ///< and its weakest direction's information share [0..1]
@@ -336,8 +338,9 @@ struct MappingSection {
   /// no cloud of its own: a patrol does not grow the map; 0: every keyframe keeps its cloud [m]
   double mapped_keyframe_distance_m = 1.5;
   // Localisation on a prior map (posed --map DIR).
-  double localise_every_m = 2.0;  ///< localised: a registration onto the map this often [m]
-  double lost_after_m = 25.0;     ///< travel without a verified fix after which it is lost [m]
+  double localise_every_m = 2.0;     ///< localised: a registration onto the map this often [m]
+  double localise_max_range_m = 60;  ///< localising: scans are cut to this range [m]
+  double lost_after_m = 25.0;        ///< travel without a verified fix after which it is lost [m]
   /// start from the pose below rather than look the place up by descriptor (as hdl_localization's
   /// specify_init_pose; rt/initialpose does the same at run time)
   bool initial_pose_given = false;

@@ -98,6 +98,8 @@ mapping::LoopClosureConfig loop_closure_config(const config::PosedConfig& config
   c.keyframe_distance_m = config.estimator.keyframe_distance_m;
   c.keyframe_angle_rad = config.estimator.keyframe_angle_deg * M_PI / 180.0;
   c.keyframe_voxel_m = m.keyframe_voxel_m;
+  c.keyframe_max_range_m = m.keyframe_max_range_m;
+  c.scan_context.max_range_m = m.scan_context_max_range_m;
   c.mapped_keyframe_distance_m = m.mapped_keyframe_distance_m;
   c.attempt_every_keyframes = m.attempt_every_keyframes;
   c.min_separation_s = m.min_separation_s;
@@ -118,6 +120,7 @@ mapping::LocalisationConfig localisation_config(const config::PosedConfig& confi
   c.keyframe_distance_m = m.localise_every_m;
   c.keyframe_angle_rad = config.estimator.keyframe_angle_deg * M_PI / 180.0;
   c.lost_after_m = m.lost_after_m;
+  c.max_range_m = m.localise_max_range_m;
   c.registration.max_rms_m = m.max_rms_m;
   c.registration.min_overlap = m.min_overlap;
   c.registration.min_constraint = m.min_constraint;

@@ -128,10 +128,12 @@ bool write_manifest(const std::string& path, const mapping::KeyframeMap& map, st
                f,
                "# posed keyframe map (docs/mapping.md, Map files)\n"
                "format: %s\nversion: %d\nframe: map\nkeyframes: %zu\nedges: %zu\nvoxel_m: %.9g\n"
+               "max_range_m: %.9g\n"
                "scan_context:\n  rings: %d\n  sectors: %d\n  max_range_m: %.9g\n"
                "  height_offset_m: %.9g\n  shift_search: %d\n",
-               kFormat, kVersion, map.keyframes.size(), map.edges.size(), map.voxel_m, sc.rings,
-               sc.sectors, sc.max_range_m, sc.height_offset_m, sc.shift_search) >= 0;
+               kFormat, kVersion, map.keyframes.size(), map.edges.size(), map.voxel_m,
+               map.max_range_m, sc.rings, sc.sectors, sc.max_range_m, sc.height_offset_m,
+               sc.shift_search) >= 0;
   });
 }
 
@@ -192,6 +194,8 @@ bool read_manifest(const std::string& path, mapping::KeyframeMap& map, std::size
   if (!manifest_value(root, "keyframes", path, keyframes, error) ||
       !manifest_value(root, "edges", path, edges, error) ||
       !manifest_value(root, "voxel_m", path, map.voxel_m, error) ||
+      // Maps saved before stop 55 kept their clouds to 60 m and did not say so.
+      (root["max_range_m"] && !manifest_value(root, "max_range_m", path, map.max_range_m, error)) ||
       !manifest_value(sc, "rings", path, map.scan_context.rings, error) ||
       !manifest_value(sc, "sectors", path, map.scan_context.sectors, error) ||
       !manifest_value(sc, "max_range_m", path, map.scan_context.max_range_m, error) ||
@@ -202,6 +206,12 @@ bool read_manifest(const std::string& path, mapping::KeyframeMap& map, std::size
   if (map.scan_context.rings <= 0 || map.scan_context.sectors <= 0 ||
       map.scan_context.rings > 1000 || map.scan_context.sectors > 3600) {
     error = at(path, 0, "scan_context: rings and sectors must be in 1..1000 and 1..3600");
+    return false;
+  }
+  if (!(map.max_range_m > 0 && map.max_range_m <= mapping::CompactCloud::kReachM)) {
+    error = at(path, 0,
+               "max_range_m must be above 0 and at most " +
+                   std::to_string(static_cast<int>(mapping::CompactCloud::kReachM)) + " m");
     return false;
   }
   return true;

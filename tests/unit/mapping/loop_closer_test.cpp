@@ -293,6 +293,33 @@ TEST(LoopCloser, RefusesALookAlikePlaceWhoseCorrectionTheOdometryCannotHaveDrift
   EXPECT_LT(closer.T_map_odom().translation().norm(), 0.5);
 }
 
+TEST(LoopCloser, KeyframeCloudsKeepThePointsWithinTheirRangeAndTheMapSaysHowFar) {
+  // A wall 90 m ahead beyond a floor near the sensor: kept with a 120 m reach, dropped with 60 m.
+  std::vector<Eigen::Vector3f> points_base;
+  for (float y = -10; y <= 10; y += 0.25f) {
+    for (float z = 0; z <= 6; z += 0.25f) points_base.emplace_back(90.0f, y, z);
+  }
+  for (float x = -20; x <= 20; x += 0.25f) {
+    for (float y = -20; y <= 20; y += 0.25f) points_base.emplace_back(x, y, -1.5f);
+  }
+  for (const double range_m : {60.0, 120.0}) {
+    LoopClosureConfig config;
+    config.keyframe_max_range_m = range_m;
+    LoopCloser closer(config);
+    closer.add_keyframe(HostTime{1'000'000'000}, Eigen::Isometry3d::Identity(), points_base);
+    const KeyframeMap map = closer.snapshot();
+    ASSERT_EQ(map.keyframes.size(), 1u);
+    EXPECT_DOUBLE_EQ(map.max_range_m, range_m);
+    int far = 0;
+    for (const Eigen::Vector3f& p : map.keyframes[0].points_base) far += p.x() > 80.0f ? 1 : 0;
+    if (range_m > 90.0) {
+      EXPECT_GT(far, 500) << "the wall is kept";
+    } else {
+      EXPECT_EQ(far, 0) << "the wall is beyond reach";
+    }
+  }
+}
+
 TEST(LoopCloser, WithoutLoopsTheCorrectionStaysIdentity) {
   const sim::LidarImuRun& run = test::simulated("room", 60.0);
   LoopClosureConfig config;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include "core/mapping/loop_closer.hpp"
 #include "tests/unit/mapping/deskewed_scan.hpp"
@@ -55,6 +57,8 @@ TEST(MapDirectory, SaveThenLoadGivesTheSameMap) {
   ASSERT_TRUE(read_map_directory(dir.string(), loaded, error)) << error;
 
   EXPECT_DOUBLE_EQ(loaded.voxel_m, saved.voxel_m);
+  EXPECT_DOUBLE_EQ(loaded.max_range_m, saved.max_range_m);
+  EXPECT_DOUBLE_EQ(loaded.scan_context.max_range_m, saved.scan_context.max_range_m);
   EXPECT_EQ(loaded.scan_context.rings, saved.scan_context.rings);
   EXPECT_EQ(loaded.scan_context.sectors, saved.scan_context.sectors);
   ASSERT_EQ(loaded.keyframes.size(), saved.keyframes.size());
@@ -122,6 +126,27 @@ TEST(MapDirectory, DamageIsNamedWithTheFileAndWhere) {
   const std::string where = (dir / "keyframes.tum").string() + ":" +
                             std::to_string(room_map().keyframes.size() + 2) + ": expected 8 fields";
   EXPECT_NE(error.find(where), std::string::npos) << error;
+
+  // A manifest from before stop 55, without the clouds' range: they were kept to 60 m. One
+  // whose range a keyframe could not hold: named.
+  ASSERT_TRUE(write_map_directory(dir.string(), room_map(), error)) << error;
+  const auto rewrite_range = [&](const std::string& replacement) {
+    std::ifstream in(dir / "map.yaml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t at = text.find("\nmax_range_m: ");
+    ASSERT_NE(at, std::string::npos) << text;
+    text.replace(at + 1, text.find('\n', at + 1) - at, replacement);
+    std::ofstream(dir / "map.yaml", std::ios::trunc) << text;
+  };
+  rewrite_range("");
+  ASSERT_TRUE(read_map_directory(dir.string(), loaded, error)) << error;
+  EXPECT_DOUBLE_EQ(loaded.max_range_m, 60.0);
+  ASSERT_TRUE(write_map_directory(dir.string(), room_map(), error)) << error;
+  rewrite_range("max_range_m: 500\n");
+  EXPECT_FALSE(read_map_directory(dir.string(), loaded, error));
+  EXPECT_NE(error.find("map.yaml: max_range_m must be above 0 and at most 131 m"),
+            std::string::npos)
+      << error;
 
   // No manifest: not a (complete) map directory.
   fs::remove(dir / "map.yaml");
