@@ -204,8 +204,13 @@ std::optional<Localiser::Fix> Localiser::register_onto(
       register_clouds(scan.points_base, target, T_first_query_guess, config_.registration);
   figures_.registration_time_s +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (!reg.accepted()) {
-    ++figures_.rejected[static_cast<std::size_t>(reg.verdict)];
+  RegistrationVerdict verdict = reg.verdict;
+  if (reg.accepted() && state_ != LocalisationState::kLocalised &&
+      reg.constraint < config_.first_fix_min_constraint) {
+    verdict = RegistrationVerdict::kDegenerate;
+  }
+  if (verdict != RegistrationVerdict::kAccepted) {
+    ++figures_.rejected[static_cast<std::size_t>(verdict)];
     return std::nullopt;
   }
   return Fix{first.T_map_base * reg.T_target_source * T_odom_query.inverse(), reg};

@@ -49,6 +49,9 @@ struct LocalisationConfig {
   double confirm_rotation_rad = 0.05;
   double lost_after_m = 25.0;  ///< travel without a fix after which the state is lost [m]
   RegistrationConfig registration;
+  /// aligning or lost: a fix must pin every direction at least this much (registration's
+  /// min_constraint while localised): a first fix has no earlier one to agree with [0..1]
+  double first_fix_min_constraint = 0.05;
 };
 
 enum class LocalisationState : std::uint8_t { kAligning, kLocalised, kLost };

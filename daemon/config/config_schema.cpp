@@ -716,6 +716,9 @@ const Field kSchema[] = {
     F("mapping.localise_max_range_m", mapping.localise_max_range_m, "60", "m", 5, 130, "",
       "localising: a scan's points this near the sensor are registered onto the map (at most "
       "the map's own keyframe range)"),
+    F("mapping.first_fix_min_constraint", mapping.first_fix_min_constraint, "0.05", "", 0, 1, "",
+      "localising: a fix while aligning or lost must pin every direction at least this much "
+      "(as mapping.min_constraint; a first fix has no earlier one to agree with)"),
     F("mapping.lost_after_m", mapping.lost_after_m, "25", "m", 1, 10000, "",
       "localising: travel without a verified registration after which the state is lost and the "
       "place is looked up again"),

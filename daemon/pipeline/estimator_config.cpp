@@ -121,6 +121,7 @@ mapping::LocalisationConfig localisation_config(const config::PosedConfig& confi
   c.keyframe_angle_rad = config.estimator.keyframe_angle_deg * M_PI / 180.0;
   c.lost_after_m = m.lost_after_m;
   c.max_range_m = m.localise_max_range_m;
+  c.first_fix_min_constraint = m.first_fix_min_constraint;
   c.registration.max_rms_m = m.max_rms_m;
   c.registration.min_overlap = m.min_overlap;
   c.registration.min_constraint = m.min_constraint;

@@ -129,6 +129,32 @@ TEST(Localiser, AnInitialPoseLocalisesAtTheFirstScan) {
   EXPECT_LT(r.worst_error_m, 0.10);
 }
 
+TEST(Localiser, AFirstFixMustPinEveryDirectionAsMuchAsAsked) {
+  // The room pins every direction well (~0.2 per point): a first fix that must reach 0.05 is
+  // taken at once; one that must reach 0.9 never is, though each registration verifies.
+  const sim::LidarImuRun& run = test::simulated("room", kRunSeconds);
+  const double start_s = 30.0;
+  const HostTime at =
+      run.scans.front().end + Duration::from_ns(static_cast<std::int64_t>(start_s * 1e9));
+  for (const double min_constraint : {0.05, 0.9}) {
+    LocalisationConfig config;
+    config.first_fix_min_constraint = min_constraint;
+    Localiser localiser(room_map(run), config);
+    localiser.set_initial_pose(run.T_map_base(at) * test::pose(0.4, -0.3, 0, 0.1));
+    const Localised r = localise(run, localiser, test::pose(-20, 3, 0, -2.0), start_s, 31.0);
+    const std::uint64_t degenerate =
+        localiser.figures().rejected[static_cast<std::size_t>(RegistrationVerdict::kDegenerate)];
+    if (min_constraint < 0.1) {
+      ASSERT_TRUE(r.seconds_to_fix);
+      EXPECT_LT(r.worst_error_m, 0.10);
+    } else {
+      EXPECT_FALSE(r.seconds_to_fix);
+      EXPECT_EQ(localiser.figures().fixes, 0u);
+      EXPECT_GT(degenerate, 5u);
+    }
+  }
+}
+
 TEST(Localiser, StaysAligningOffTheMap) {
   // A map of the room, a robot in the corridor: nothing may be taken for a fix.
   const sim::LidarImuRun& room = test::simulated("room", kRunSeconds);
