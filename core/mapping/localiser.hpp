@@ -42,7 +42,7 @@ struct LocalisationConfig {
   /// [m]
   double track_radius_m = 12.0;
   int track_keyframes = 10;                ///< at most this many of them, nearest first [1]
-  double scan_context_max_distance = 0.3;  ///< descriptor lookups: at most this distance
+  double scan_context_max_distance = 0.4;  ///< descriptor lookups: at most this distance
   int ring_key_candidates = 10;            ///< nearest ring keys compared in full [1]
   /// a descriptor fix is taken when the next attempt's agrees within these [m], [rad]
   double confirm_translation_m = 0.5;

@@ -716,6 +716,10 @@ const Field kSchema[] = {
     F("mapping.localise_max_range_m", mapping.localise_max_range_m, "60", "m", 5, 130, "",
       "localising: a scan's points this near the sensor are registered onto the map (at most "
       "the map's own keyframe range)"),
+    F("mapping.localise_scan_context_max_distance", mapping.localise_scan_context_max_distance,
+      "0.4", "", 0, 1, "",
+      "localising: a descriptor lookup registers onto map keyframes whose Scan Context is at "
+      "most this far from the scan's"),
     F("mapping.first_fix_min_constraint", mapping.first_fix_min_constraint, "0.05", "", 0, 1, "",
       "localising: a fix while aligning or lost must pin every direction at least this much "
       "(as mapping.min_constraint; a first fix has no earlier one to agree with)"),

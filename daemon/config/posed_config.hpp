@@ -340,7 +340,8 @@ struct MappingSection {
   // Localisation on a prior map (posed --map DIR).
   double localise_every_m = 2.0;     ///< localised: a registration onto the map this often [m]
   double localise_max_range_m = 60;  ///< localising: scans are cut to this range [m]
-  double first_fix_min_constraint = 0.05;  ///< localising: a first fix's weakest direction
+  double localise_scan_context_max_distance = 0.4;  ///< localising: descriptor lookups
+  double first_fix_min_constraint = 0.05;           ///< localising: a first fix's weakest direction
   double lost_after_m = 25.0;  ///< travel without a verified fix after which it is lost [m]
   /// start from the pose below rather than look the place up by descriptor (as hdl_localization's
   /// specify_init_pose; rt/initialpose does the same at run time)

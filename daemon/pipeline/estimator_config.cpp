@@ -122,6 +122,7 @@ mapping::LocalisationConfig localisation_config(const config::PosedConfig& confi
   c.lost_after_m = m.lost_after_m;
   c.max_range_m = m.localise_max_range_m;
   c.first_fix_min_constraint = m.first_fix_min_constraint;
+  c.scan_context_max_distance = m.localise_scan_context_max_distance;
   c.registration.max_rms_m = m.max_rms_m;
   c.registration.min_overlap = m.min_overlap;
   c.registration.min_constraint = m.min_constraint;
