@@ -199,18 +199,19 @@ std::optional<Localiser::Fix> Localiser::register_onto(
       }
     }
   }
+  // A first fix has no earlier one to agree with, so it must pin every direction harder.
+  RegistrationConfig registration = config_.registration;
+  if (state_ != LocalisationState::kLocalised) {
+    registration.min_constraint =
+        std::max(registration.min_constraint, config_.first_fix_min_constraint);
+  }
   const auto started = std::chrono::steady_clock::now();
   const RegistrationResult reg =
-      register_clouds(scan.points_base, target, T_first_query_guess, config_.registration);
+      register_clouds(scan.points_base, target, T_first_query_guess, registration);
   figures_.registration_time_s +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  RegistrationVerdict verdict = reg.verdict;
-  if (reg.accepted() && state_ != LocalisationState::kLocalised &&
-      reg.constraint < config_.first_fix_min_constraint) {
-    verdict = RegistrationVerdict::kDegenerate;
-  }
-  if (verdict != RegistrationVerdict::kAccepted) {
-    ++figures_.rejected[static_cast<std::size_t>(verdict)];
+  if (!reg.accepted()) {
+    ++figures_.rejected[static_cast<std::size_t>(reg.verdict)];
     return std::nullopt;
   }
   return Fix{first.T_map_base * reg.T_target_source * T_odom_query.inverse(), reg};
